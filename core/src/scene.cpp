@@ -1,0 +1,132 @@
+#include "physval/core/scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace physval {
+
+int Scene::steps() const {
+  const double n = std::round(duration / dt);
+  return n < 1.0 ? 1 : static_cast<int>(n);
+}
+
+int Scene::body_index(const std::string& body_name) const {
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (bodies[i].name == body_name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+MaterialView material_of(const BodyDef& b) {
+  return {b.name, b.restitution, b.friction, b.static_friction, b.rolling_friction};
+}
+
+MaterialView material_of(const std::string& name, const StaticMaterial& m) {
+  return {name, m.restitution, m.friction, m.static_friction, m.rolling_friction};
+}
+
+PairMaterial combine_materials(const Scene& scene, const MaterialView& a, const MaterialView& b) {
+  PairMaterial pm;
+  pm.restitution = std::min(a.restitution, b.restitution);
+  pm.friction = std::sqrt(a.friction * b.friction);
+  pm.static_friction = std::sqrt(a.static_friction * b.static_friction);
+  pm.rolling_friction = std::sqrt(a.rolling_friction * b.rolling_friction);
+  for (const MaterialOverride& o : scene.materials) {
+    const bool match = (o.a == a.name && o.b == b.name) || (o.a == b.name && o.b == a.name);
+    if (!match) continue;
+    if (o.restitution) pm.restitution = *o.restitution;
+    if (o.friction) pm.friction = *o.friction;
+    if (o.static_friction) pm.static_friction = *o.static_friction;
+    if (o.rolling_friction) pm.rolling_friction = *o.rolling_friction;
+    if (o.friction && !o.static_friction) pm.static_friction = std::max(pm.static_friction, *o.friction);
+  }
+  return pm;
+}
+
+PairResponse response_between(const Scene& scene, const std::string& group_first,
+                              const std::string& group_second) {
+  PairResponse r;
+  for (const CollisionRule& rule : scene.collision_matrix) {
+    bool swapped;
+    if (rule.a == group_first && rule.b == group_second) {
+      swapped = false;
+    } else if (rule.a == group_second && rule.b == group_first) {
+      swapped = true;
+    } else {
+      continue;
+    }
+    switch (rule.response) {
+      case CollisionResponse::Bounce: break;
+      case CollisionResponse::Ignore: r.collide = false; r.event = false; break;
+      case CollisionResponse::Event: r.collide = false; r.event = true; break;
+      case CollisionResponse::DestroyA: (swapped ? r.destroy_second : r.destroy_first) = true; break;
+      case CollisionResponse::DestroyB: (swapped ? r.destroy_first : r.destroy_second) = true; break;
+      case CollisionResponse::DestroyBoth: r.destroy_first = r.destroy_second = true; break;
+    }
+    return r;
+  }
+  return r;
+}
+
+const char* feature_name(Feature f) {
+  switch (f) {
+    case Feature::Circles: return "circles";
+    case Feature::Points: return "points";
+    case Feature::StaticBodies: return "static_bodies";
+    case Feature::Walls: return "walls";
+    case Feature::Boxes: return "boxes";
+    case Feature::Surfaces: return "surfaces";
+    case Feature::UniformGravity: return "uniform_gravity";
+    case Feature::NewtonianGravity: return "newtonian_gravity";
+    case Feature::LinearDrag: return "linear_drag";
+    case Feature::QuadraticDrag: return "quadratic_drag";
+    case Feature::Wind: return "wind";
+    case Feature::Thrust: return "thrust";
+    case Feature::Friction: return "friction";
+    case Feature::StaticFriction: return "static_friction";
+    case Feature::RollingFriction: return "rolling_friction";
+    case Feature::MaterialOverrides: return "material_overrides";
+    case Feature::CollisionMatrix: return "collision_matrix";
+    case Feature::Particles: return "particles";
+    case Feature::Count: break;
+  }
+  return "unknown";
+}
+
+std::vector<Feature> scene_features(const Scene& scene) {
+  bool used[static_cast<int>(Feature::Count)] = {};
+  auto use = [&](Feature f) { used[static_cast<int>(f)] = true; };
+  auto material = [&](double friction, double static_friction, double rolling) {
+    if (friction > 0.0 || static_friction > 0.0) use(Feature::Friction);
+    if (static_friction > friction) use(Feature::StaticFriction);
+    if (rolling > 0.0) use(Feature::RollingFriction);
+  };
+  for (const BodyDef& b : scene.bodies) {
+    use(b.shape == ShapeKind::Circle ? Feature::Circles : Feature::Points);
+    if (b.is_static) use(Feature::StaticBodies);
+    if (b.drag_linear > 0.0) use(Feature::LinearDrag);
+    if (b.drag_quadratic > 0.0) use(Feature::QuadraticDrag);
+    if (b.thrust.enabled()) use(Feature::Thrust);
+    material(b.friction, b.static_friction, b.rolling_friction);
+  }
+  if (!scene.walls.empty()) use(Feature::Walls);
+  if (!scene.boxes.empty()) use(Feature::Boxes);
+  if (!scene.surfaces.empty()) use(Feature::Surfaces);
+  for (const WallDef& w : scene.walls) material(w.material.friction, w.material.static_friction, w.material.rolling_friction);
+  for (const BoxDef& w : scene.boxes) material(w.material.friction, w.material.static_friction, w.material.rolling_friction);
+  for (const SurfaceDef& w : scene.surfaces) material(w.material.friction, w.material.static_friction, w.material.rolling_friction);
+  if (scene.world.gravity.x != 0.0 || scene.world.gravity.y != 0.0) use(Feature::UniformGravity);
+  if (scene.world.newtonian) use(Feature::NewtonianGravity);
+  const bool drag = used[static_cast<int>(Feature::LinearDrag)] || used[static_cast<int>(Feature::QuadraticDrag)];
+  if (drag && (scene.world.wind.x != 0.0 || scene.world.wind.y != 0.0)) use(Feature::Wind);
+  if (!scene.materials.empty()) use(Feature::MaterialOverrides);
+  if (!scene.collision_matrix.empty()) use(Feature::CollisionMatrix);
+  if (!scene.emitters.empty()) use(Feature::Particles);
+  std::vector<Feature> out;
+  for (int i = 0; i < static_cast<int>(Feature::Count); ++i) {
+    if (used[i]) out.push_back(static_cast<Feature>(i));
+  }
+  return out;
+}
+
+}  // namespace physval
