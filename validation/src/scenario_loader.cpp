@@ -1,1 +1,854 @@
-// placeholder
+// TOML scenario files -> Scene. The reader walks each table with a TableReader that
+// records which keys it consumed, so every key it did not expect is reported with its
+// line, and every error in a file is collected before giving up.
+#include "physval/validation/scenario_loader.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include <toml++/toml.hpp>
+
+#include "physval/adapters/registry.hpp"
+#include "physval/validation/metric_names.hpp"
+
+namespace physval {
+
+std::string Diagnostic::str() const {
+  std::ostringstream os;
+  os << file;
+  if (line > 0) {
+    os << ':' << line;
+    if (column > 0) os << ':' << column;
+  }
+  os << ": ";
+  if (!key.empty()) os << key << ": ";
+  os << message;
+  return os.str();
+}
+
+namespace {
+
+const char* type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a float";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::date:
+    case toml::node_type::time:
+    case toml::node_type::date_time: return "a date/time";
+    default: return "nothing";
+  }
+}
+
+std::string format_number(double v) {
+  std::ostringstream os;
+  os.precision(10);
+  os << v;
+  return os.str();
+}
+
+struct Context {
+  std::string file;
+  Diagnostics errors;
+
+  void error(const toml::source_region& where, const std::string& key, const std::string& message) {
+    errors.push_back({file, static_cast<int>(where.begin.line), static_cast<int>(where.begin.column), key, message});
+  }
+};
+
+// Reads one TOML table, tracking the keys it used; finish() reports the rest.
+class TableReader {
+ public:
+  TableReader(Context& ctx, const toml::table& table, std::string path)
+      : ctx_(ctx), table_(table), path_(std::move(path)) {}
+  TableReader(const TableReader&) = delete;
+  TableReader& operator=(const TableReader&) = delete;
+  ~TableReader() { finish(); }
+
+  const toml::table& table() const { return table_; }
+  const std::string& path() const { return path_; }
+  std::string key_path(std::string_view key) const {
+    return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+  }
+
+  // The node for key (marking it used), or nullptr.
+  const toml::node* node(std::string_view key) {
+    used_.insert(std::string(key));
+    return table_.get(key);
+  }
+  bool has(std::string_view key) const { return table_.contains(key); }
+
+  void error_at(const toml::node& n, std::string_view key, const std::string& message) {
+    ctx_.error(n.source(), key_path(key), message);
+  }
+  void error_here(std::string_view key, const std::string& message) {
+    ctx_.error(table_.source(), key_path(key), message);
+  }
+
+  void missing(std::string_view key) { error_here(key, "required key is missing"); }
+
+  std::optional<double> number(std::string_view key, bool required = false) {
+    const toml::node* n = node(key);
+    if (n == nullptr) {
+      if (required) missing(key);
+      return std::nullopt;
+    }
+    return to_number(*n, key_path(key));
+  }
+
+  std::optional<double> to_number(const toml::node& n, const std::string& kp) {
+    double v;
+    if (const auto* f = n.as_floating_point()) {
+      v = f->get();
+    } else if (const auto* i = n.as_integer()) {
+      v = static_cast<double>(i->get());
+    } else {
+      ctx_.error(n.source(), kp, std::string("expected a number, got ") + type_name(n));
+      return std::nullopt;
+    }
+    if (!std::isfinite(v)) {
+      ctx_.error(n.source(), kp, "must be a finite number, got " + format_number(v));
+      return std::nullopt;
+    }
+    return v;
+  }
+
+  // A number with a range check: pred returns "" when fine, else what it must be.
+  void read(std::string_view key, double& out, const char* must = nullptr,
+            const std::function<bool(double)>& ok = {}) {
+    const toml::node* n = node(key);
+    if (n == nullptr) return;
+    if (auto v = to_number(*n, key_path(key))) {
+      if (ok && !ok(*v)) {
+        error_at(*n, key, std::string("must be ") + must + ", got " + format_number(*v));
+        return;
+      }
+      out = *v;
+    }
+  }
+  void read_required(std::string_view key, double& out, const char* must = nullptr,
+                     const std::function<bool(double)>& ok = {}) {
+    if (!has(key)) {
+      node(key);
+      missing(key);
+      return;
+    }
+    read(key, out, must, ok);
+  }
+  void read_non_negative(std::string_view key, double& out) {
+    read(key, out, ">= 0", [](double v) { return v >= 0.0; });
+  }
+
+  void read(std::string_view key, bool& out) {
+    const toml::node* n = node(key);
+    if (n == nullptr) return;
+    if (const auto* b = n->as_boolean()) {
+      out = b->get();
+    } else {
+      error_at(*n, key, std::string("expected a boolean, got ") + type_name(*n));
+    }
+  }
+
+  void read(std::string_view key, std::optional<bool>& out) {
+    bool v = false;
+    const toml::node* n = table_.get(key);
+    read(key, v);
+    if (n != nullptr && n->is_boolean()) out = v;
+  }
+
+  bool read(std::string_view key, std::string& out, bool required = false) {
+    const toml::node* n = node(key);
+    if (n == nullptr) {
+      if (required) missing(key);
+      return false;
+    }
+    if (const auto* s = n->as_string()) {
+      out = s->get();
+      return true;
+    }
+    error_at(*n, key, std::string("expected a string, got ") + type_name(*n));
+    return false;
+  }
+
+  // A choice among names; returns the index.
+  std::optional<std::size_t> choice(std::string_view key, const std::vector<std::string>& names) {
+    std::string s;
+    const toml::node* n = table_.get(key);
+    if (!read(key, s)) return std::nullopt;
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      if (names[i] == s) return i;
+    }
+    std::string all;
+    for (const std::string& c : names) all += (all.empty() ? "" : " | ") + c;
+    error_at(*n, key, "unknown value \"" + s + "\"; expected one of " + all);
+    return std::nullopt;
+  }
+
+  std::optional<Vec2> vec2(const toml::node& n, const std::string& kp) {
+    const auto* a = n.as_array();
+    if (a == nullptr || a->size() != 2) {
+      ctx_.error(n.source(), kp, std::string("expected a 2-D vector [x, y], got ") +
+                                     (a ? "an array of " + std::to_string(a->size()) : std::string(type_name(n))));
+      return std::nullopt;
+    }
+    auto x = to_number(*a->get(0), kp + "[0]");
+    auto y = to_number(*a->get(1), kp + "[1]");
+    if (!x || !y) return std::nullopt;
+    return Vec2{*x, *y};
+  }
+  std::optional<Vec2> vec2(std::string_view key, bool required = false) {
+    const toml::node* n = node(key);
+    if (n == nullptr) {
+      if (required) missing(key);
+      return std::nullopt;
+    }
+    return vec2(*n, key_path(key));
+  }
+  void read(std::string_view key, Vec2& out, bool required = false) {
+    if (auto v = vec2(key, required)) out = *v;
+  }
+
+  std::optional<std::vector<double>> numbers(const toml::node& n, const std::string& kp) {
+    const auto* a = n.as_array();
+    if (a == nullptr) {
+      ctx_.error(n.source(), kp, std::string("expected an array of numbers, got ") + type_name(n));
+      return std::nullopt;
+    }
+    std::vector<double> out;
+    bool ok = true;
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      if (auto v = to_number(*a->get(i), kp + "[" + std::to_string(i) + "]")) {
+        out.push_back(*v);
+      } else {
+        ok = false;
+      }
+    }
+    if (!ok) return std::nullopt;
+    return out;
+  }
+
+  // An array of tables (`[[key]]` or an inline array of inline tables).
+  std::vector<const toml::table*> tables(std::string_view key) {
+    std::vector<const toml::table*> out;
+    const toml::node* n = node(key);
+    if (n == nullptr) return out;
+    if (const auto* t = n->as_table()) {  // a single table is accepted as a list of one
+      out.push_back(t);
+      return out;
+    }
+    const auto* a = n->as_array();
+    if (a == nullptr) {
+      error_at(*n, key, std::string("expected an array of tables, got ") + type_name(*n));
+      return out;
+    }
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      if (const auto* t = a->get(i)->as_table()) {
+        out.push_back(t);
+      } else {
+        ctx_.error(a->get(i)->source(), key_path(key) + "[" + std::to_string(i) + "]",
+                   std::string("expected a table, got ") + type_name(*a->get(i)));
+      }
+    }
+    return out;
+  }
+
+  const toml::table* subtable(std::string_view key) {
+    const toml::node* n = node(key);
+    if (n == nullptr) return nullptr;
+    if (const auto* t = n->as_table()) return t;
+    error_at(*n, key, std::string("expected a table, got ") + type_name(*n));
+    return nullptr;
+  }
+
+  void mark_used(std::string_view key) { used_.insert(std::string(key)); }
+
+  void finish() {
+    if (finished_) return;
+    finished_ = true;
+    for (auto&& [k, v] : table_) {
+      if (used_.count(std::string(k.str())) == 0) {
+        ctx_.error(k.source(), key_path(k.str()), "unknown key");
+      }
+    }
+  }
+
+ private:
+  Context& ctx_;
+  const toml::table& table_;
+  std::string path_;
+  std::set<std::string> used_;
+  bool finished_ = false;
+};
+
+std::string indexed(const std::string& base, std::size_t i) { return base + "[" + std::to_string(i) + "]"; }
+
+void read_material(TableReader& r, StaticMaterial& m) {
+  r.read_non_negative("restitution", m.restitution);
+  r.read_non_negative("friction", m.friction);
+  m.static_friction = m.friction;
+  r.read_non_negative("static_friction", m.static_friction);
+  r.read_non_negative("rolling_friction", m.rolling_friction);
+  r.read("group", m.group);
+  if (m.static_friction < m.friction && r.has("static_friction")) {
+    r.error_here("static_friction", "must be >= friction (mu_s >= mu_k), got " + format_number(m.static_friction) +
+                                         " < " + format_number(m.friction));
+  }
+}
+
+void read_thrust(Context& ctx, const toml::table& t, const std::string& path, ThrustDef& th) {
+  TableReader r(ctx, t, path);
+  const toml::node* speeds = r.node("speeds");
+  if (speeds == nullptr) {
+    r.missing("speeds");
+  } else if (auto v = r.numbers(*speeds, r.key_path("speeds"))) {
+    th.speeds = *v;
+    if (th.speeds.empty()) r.error_at(*speeds, "speeds", "must hold at least one speed");
+    for (std::size_t i = 1; i < th.speeds.size(); ++i) {
+      if (!(th.speeds[i] > th.speeds[i - 1])) {
+        r.error_at(*speeds, "speeds", "must be strictly increasing");
+        break;
+      }
+    }
+  }
+  if (const toml::node* gears = r.node("gears")) {
+    if (auto v = r.numbers(*gears, r.key_path("gears"))) {
+      th.gears = *v;
+      for (std::size_t i = 1; i < th.gears.size(); ++i) {
+        if (!(th.gears[i] > th.gears[i - 1])) {
+          r.error_at(*gears, "gears", "must be strictly increasing");
+          break;
+        }
+      }
+    }
+  }
+  const toml::node* accel = r.node("accel");
+  if (accel == nullptr) {
+    r.missing("accel");
+  } else if (const auto* a = accel->as_array()) {
+    const bool two_inputs = !th.gears.empty();
+    if (!two_inputs) {
+      if (auto row = r.numbers(*accel, r.key_path("accel"))) th.accel = {*row};
+    } else {
+      for (std::size_t g = 0; g < a->size(); ++g) {
+        if (auto row = r.numbers(*a->get(g), indexed(r.key_path("accel"), g))) th.accel.push_back(*row);
+      }
+      if (th.accel.size() != th.gears.size()) {
+        r.error_at(*accel, "accel", "needs one row per gear (" + std::to_string(th.gears.size()) + "), got " +
+                                        std::to_string(th.accel.size()));
+      }
+    }
+    for (const auto& row : th.accel) {
+      if (row.size() != th.speeds.size() && !th.speeds.empty()) {
+        r.error_at(*accel, "accel", "each row needs one value per speed (" + std::to_string(th.speeds.size()) + ")");
+        break;
+      }
+    }
+  } else {
+    r.error_at(*accel, "accel", std::string("expected an array, got ") + type_name(*accel));
+  }
+  r.read("throttle", th.throttle);
+  r.read("gear", th.gear);
+  if (th.accel.empty() || th.speeds.empty()) th = ThrustDef{};
+}
+
+void read_body(Context& ctx, const toml::table& t, std::size_t i, BodyDef& b) {
+  TableReader r(ctx, t, indexed("bodies", i));
+  b.line = static_cast<int>(t.source().begin.line);
+  r.read("name", b.name, true);
+  if (auto s = r.choice("shape", {"circle", "point"})) b.shape = *s == 0 ? ShapeKind::Circle : ShapeKind::Point;
+  if (b.shape == ShapeKind::Circle) {
+    r.read_required("radius", b.radius, "> 0", [](double v) { return v > 0.0; });
+  } else {
+    r.read("radius", b.radius, "0 for a point", [](double v) { return v == 0.0; });
+  }
+  r.read("static", b.is_static);
+  r.read("mass", b.mass, "> 0", [](double v) { return v > 0.0; });
+  r.read("position", b.position, true);
+  r.read("velocity", b.velocity);
+  r.read("angle", b.angle);
+  r.read("angular_velocity", b.angular_velocity);
+  r.read_non_negative("restitution", b.restitution);
+  r.read_non_negative("friction", b.friction);
+  b.static_friction = b.friction;
+  r.read_non_negative("static_friction", b.static_friction);
+  if (r.has("static_friction") && b.static_friction < b.friction) {
+    r.error_here("static_friction", "must be >= friction (mu_s >= mu_k)");
+  }
+  r.read_non_negative("rolling_friction", b.rolling_friction);
+  r.read_non_negative("drag_linear", b.drag_linear);
+  r.read_non_negative("drag_quadratic", b.drag_quadratic);
+  r.read("group", b.group);
+  if (const toml::table* th = r.subtable("thrust")) read_thrust(ctx, *th, r.key_path("thrust"), b.thrust);
+}
+
+void read_world(Context& ctx, const toml::table& t, WorldDef& w) {
+  TableReader r(ctx, t, "world");
+  r.read("gravity", w.gravity);
+  r.read("wind", w.wind);
+  r.read("newtonian", w.newtonian);
+  r.read("G", w.G, "> 0", [](double v) { return v > 0.0; });
+  r.read_non_negative("softening", w.softening);
+  if ((r.has("G") || r.has("softening")) && !w.newtonian) {
+    r.error_here(r.has("G") ? "G" : "softening", "has no effect unless newtonian = true");
+  }
+}
+
+std::optional<ExpectedContact> read_expected_contact(Context& ctx, const toml::table& t, const std::string& path) {
+  TableReader r(ctx, t, path);
+  ExpectedContact c;
+  r.read("a", c.a, true);
+  r.read("b", c.b, true);
+  auto time = r.number("time", true);
+  if (time) c.time = *time;
+  c.tolerance = r.number("tolerance");
+  if (c.a.empty() || c.b.empty() || !time) return std::nullopt;
+  return c;
+}
+
+void read_expect(Context& ctx, const toml::table& t, Expectations& e) {
+  TableReader r(ctx, t, "expect");
+  if (const toml::table* fc = r.subtable("first_contact")) {
+    e.first_contact = read_expected_contact(ctx, *fc, "expect.first_contact");
+  }
+  auto list = r.tables("contacts");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    if (auto c = read_expected_contact(ctx, *list[i], indexed("expect.contacts", i))) e.contacts.push_back(*c);
+  }
+  list = r.tables("final");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    TableReader fr(ctx, *list[i], indexed("expect.final", i));
+    ExpectedFinal f;
+    fr.read("body", f.body, true);
+    f.position = fr.vec2("position");
+    f.velocity = fr.vec2("velocity");
+    f.tolerance = fr.number("tolerance");
+    if (!f.position && !f.velocity && !fr.has("position") && !fr.has("velocity")) {
+      fr.error_here("position", "a final expectation needs a position or a velocity");
+    }
+    e.final_states.push_back(f);
+  }
+  list = r.tables("apex");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    TableReader ar(ctx, *list[i], indexed("expect.apex", i));
+    ExpectedApex a;
+    ar.read("body", a.body, true);
+    if (auto h = ar.number("height", true)) a.height = *h;
+    a.time = ar.number("time");
+    a.tolerance = ar.number("tolerance");
+    e.apex.push_back(a);
+  }
+  list = r.tables("period");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    TableReader pr(ctx, *list[i], indexed("expect.period", i));
+    ExpectedPeriod p;
+    pr.read("body", p.body, true);
+    pr.read("around", p.around);
+    pr.read_required("period", p.period, "> 0", [](double v) { return v > 0.0; });
+    p.tolerance = pr.number("tolerance");
+    e.period.push_back(p);
+  }
+}
+
+void read_gate_limits(TableReader& r, std::map<std::string, double>& limits,
+                      const std::function<bool(std::string_view)>& is_subtable) {
+  for (auto&& [k, v] : r.table()) {
+    const std::string key(k.str());
+    if (is_subtable(key)) continue;
+    if (!is_metric_name(key)) continue;  // left unused: finish() reports it as unknown
+    r.mark_used(key);
+    if (auto n = r.to_number(v, r.key_path(key))) {
+      if (*n < 0.0) {
+        r.error_at(v, key, "a limit must be >= 0, got " + format_number(*n));
+      } else {
+        limits[key] = *n;
+      }
+    }
+  }
+}
+
+void read_gate(Context& ctx, const toml::table& t, GateDef& g) {
+  TableReader r(ctx, t, "gate");
+  auto is_engine = [](std::string_view k) { return find_engine(std::string(k)) != nullptr; };
+  read_gate_limits(r, g.limits, is_engine);
+  for (const EngineFactory& f : engine_registry()) {
+    if (const toml::table* sub = r.subtable(f.info.name)) {
+      TableReader er(ctx, *sub, "gate." + f.info.name);
+      read_gate_limits(er, g.per_engine[f.info.name], [](std::string_view) { return false; });
+    }
+  }
+}
+
+void read_engine_options(Context& ctx, const toml::table& t, const EngineInfo& info, EngineOptions& out) {
+  TableReader r(ctx, t, info.name);
+  for (const OptionSpec& spec : info.options) {
+    const toml::node* n = r.node(spec.key);
+    if (n == nullptr) continue;
+    const std::string kp = r.key_path(spec.key);
+    switch (spec.default_value.index()) {
+      case 0:
+        if (const auto* b = n->as_boolean()) {
+          out[spec.key] = b->get();
+        } else {
+          r.error_at(*n, spec.key, std::string("expected a boolean, got ") + type_name(*n));
+        }
+        break;
+      case 1:
+        if (const auto* i = n->as_integer()) {
+          out[spec.key] = static_cast<std::int64_t>(i->get());
+        } else {
+          r.error_at(*n, spec.key, std::string("expected an integer, got ") + type_name(*n));
+        }
+        break;
+      case 2:
+        if (auto v = r.to_number(*n, kp)) out[spec.key] = *v;
+        break;
+      default: {
+        std::string s;
+        if (!r.read(spec.key, s)) break;
+        if (!spec.choices.empty() && std::find(spec.choices.begin(), spec.choices.end(), s) == spec.choices.end()) {
+          std::string all;
+          for (const std::string& c : spec.choices) all += (all.empty() ? "" : " | ") + c;
+          r.error_at(*n, spec.key, "unknown value \"" + s + "\"; expected one of " + all);
+          break;
+        }
+        out[spec.key] = s;
+      }
+    }
+  }
+}
+
+// Checks that need the whole scene: unique names, references by name.
+void check_references(Context& ctx, const toml::table& root, Scene& s) {
+  auto where = [&](std::string_view array, std::size_t i) -> toml::source_region {
+    if (const auto* a = root.get_as<toml::array>(array)) {
+      if (i < a->size()) return a->get(i)->source();
+    }
+    if (const auto* t = root.get_as<toml::table>(array)) return t->source();
+    return root.source();
+  };
+  std::map<std::string, std::string> names;   // name -> what it is
+  auto claim = [&](const std::string& name, const std::string& what, std::string_view array, std::size_t i) {
+    if (name.empty()) return;
+    auto [it, fresh] = names.emplace(name, what);
+    if (!fresh) ctx.error(where(array, i), indexed(std::string(array), i) + ".name",
+                          "duplicate name \"" + name + "\" (already used by " + it->second + ")");
+  };
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) claim(s.bodies[i].name, "a body", "bodies", i);
+  for (std::size_t i = 0; i < s.walls.size(); ++i) claim(s.walls[i].name, "a wall", "walls", i);
+  for (std::size_t i = 0; i < s.boxes.size(); ++i) claim(s.boxes[i].name, "a box", "boxes", i);
+  for (std::size_t i = 0; i < s.surfaces.size(); ++i) claim(s.surfaces[i].name, "a surface", "surfaces", i);
+
+  auto body_exists = [&](const std::string& n) { return s.body_index(n) >= 0; };
+  auto object_exists = [&](const std::string& n) { return names.count(n) > 0; };
+  const toml::table* expect = root.get_as<toml::table>("expect");
+  auto expect_where = [&]() { return expect ? expect->source() : root.source(); };
+  auto check = [&](bool ok, const std::string& key, const std::string& name, const char* what) {
+    if (!ok) ctx.error(expect_where(), key, std::string("no ") + what + " named \"" + name + "\"");
+  };
+  if (s.expect.first_contact) {
+    check(object_exists(s.expect.first_contact->a), "expect.first_contact.a", s.expect.first_contact->a, "body or barrier");
+    check(object_exists(s.expect.first_contact->b), "expect.first_contact.b", s.expect.first_contact->b, "body or barrier");
+  }
+  for (std::size_t i = 0; i < s.expect.contacts.size(); ++i) {
+    check(object_exists(s.expect.contacts[i].a), indexed("expect.contacts", i) + ".a", s.expect.contacts[i].a, "body or barrier");
+    check(object_exists(s.expect.contacts[i].b), indexed("expect.contacts", i) + ".b", s.expect.contacts[i].b, "body or barrier");
+  }
+  for (std::size_t i = 0; i < s.expect.final_states.size(); ++i) {
+    check(body_exists(s.expect.final_states[i].body), indexed("expect.final", i) + ".body", s.expect.final_states[i].body, "body");
+  }
+  for (std::size_t i = 0; i < s.expect.apex.size(); ++i) {
+    check(body_exists(s.expect.apex[i].body), indexed("expect.apex", i) + ".body", s.expect.apex[i].body, "body");
+  }
+  for (std::size_t i = 0; i < s.expect.period.size(); ++i) {
+    check(body_exists(s.expect.period[i].body), indexed("expect.period", i) + ".body", s.expect.period[i].body, "body");
+  }
+  for (std::size_t i = 0; i < s.materials.size(); ++i) {
+    for (const std::string* n : {&s.materials[i].a, &s.materials[i].b}) {
+      if (!object_exists(*n)) ctx.error(where("materials", i), indexed("materials", i) + (n == &s.materials[i].a ? ".a" : ".b"),
+                                        "no body or barrier named \"" + *n + "\"");
+    }
+  }
+  for (std::size_t i = 0; i < s.emitters.size(); ++i) {
+    if (!body_exists(s.emitters[i].parent)) {
+      ctx.error(where("emitters", i), indexed("emitters", i) + ".parent", "no body named \"" + s.emitters[i].parent + "\"");
+    }
+  }
+  for (std::size_t i = 0; i < s.bodies.size(); ++i) {
+    if (s.bodies[i].is_static && s.bodies[i].shape == ShapeKind::Point) {
+      ctx.error(where("bodies", i), indexed("bodies", i) + ".static", "a static body must be a circle");
+    }
+  }
+}
+
+Scene read_scene(Context& ctx, const toml::table& root) {
+  Scene s;
+  s.source_file = ctx.file;
+  TableReader r(ctx, root, "");
+  if (r.read("name", s.name, true)) {
+    static const std::regex kName("[a-z0-9_]+");
+    if (!std::regex_match(s.name, kName)) {
+      r.error_at(*root.get("name"), "name", "must match [a-z0-9_]+, got \"" + s.name + "\"");
+    }
+  }
+  r.read("description", s.description);
+  r.read_required("duration", s.duration, "> 0", [](double v) { return v > 0.0; });
+  r.read("dt", s.dt, "> 0", [](double v) { return v > 0.0; });
+  r.read("sample_interval", s.sample_interval, ">= 0", [](double v) { return v >= 0.0; });
+  if (const toml::node* n = r.node("engines")) {
+    const auto* a = n->as_array();
+    if (a == nullptr) {
+      r.error_at(*n, "engines", std::string("expected an array of engine names, got ") + type_name(*n));
+    } else {
+      for (std::size_t i = 0; i < a->size(); ++i) {
+        const auto* str = a->get(i)->as_string();
+        if (str == nullptr || find_engine(str->get()) == nullptr) {
+          ctx.error(a->get(i)->source(), indexed("engines", i), "not an engine physval knows (see `physval engines`)");
+        } else {
+          s.engines.push_back(str->get());
+        }
+      }
+    }
+  }
+  if (const toml::table* w = r.subtable("world")) read_world(ctx, *w, s.world);
+
+  auto bodies = r.tables("bodies");
+  s.bodies.resize(bodies.size());
+  for (std::size_t i = 0; i < bodies.size(); ++i) read_body(ctx, *bodies[i], i, s.bodies[i]);
+
+  auto walls = r.tables("walls");
+  for (std::size_t i = 0; i < walls.size(); ++i) {
+    TableReader wr(ctx, *walls[i], indexed("walls", i));
+    WallDef w;
+    w.line = static_cast<int>(walls[i]->source().begin.line);
+    w.name = "wall" + std::to_string(i);
+    wr.read("name", w.name);
+    wr.read("from", w.from, true);
+    wr.read("to", w.to, true);
+    read_material(wr, w.material);
+    if (wr.has("from") && wr.has("to") && w.from == w.to) wr.error_here("to", "a wall must have non-zero length");
+    s.walls.push_back(w);
+  }
+  auto boxes = r.tables("boxes");
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    TableReader br(ctx, *boxes[i], indexed("boxes", i));
+    BoxDef b;
+    b.line = static_cast<int>(boxes[i]->source().begin.line);
+    b.name = "box" + std::to_string(i);
+    br.read("name", b.name);
+    br.read("min", b.min, true);
+    br.read("max", b.max, true);
+    read_material(br, b.material);
+    if (br.has("min") && br.has("max") && !(b.max.x > b.min.x && b.max.y > b.min.y)) {
+      br.error_here("max", "must be greater than min in x and y");
+    }
+    s.boxes.push_back(b);
+  }
+  auto surfaces = r.tables("surfaces");
+  for (std::size_t i = 0; i < surfaces.size(); ++i) {
+    TableReader sr(ctx, *surfaces[i], indexed("surfaces", i));
+    SurfaceDef sd;
+    sd.line = static_cast<int>(surfaces[i]->source().begin.line);
+    sd.name = "surface" + std::to_string(i);
+    sr.read("name", sd.name);
+    if (const toml::node* pts = sr.node("points")) {
+      if (const auto* a = pts->as_array()) {
+        for (std::size_t k = 0; k < a->size(); ++k) {
+          if (auto v = sr.vec2(*a->get(k), indexed(sr.key_path("points"), k))) sd.points.push_back(*v);
+        }
+        if (sd.points.size() < 2) sr.error_at(*pts, "points", "a surface needs at least 2 points");
+        for (std::size_t k = 1; k < sd.points.size(); ++k) {
+          if (sd.points[k] == sd.points[k - 1]) {
+            sr.error_at(*pts, "points", "consecutive points must differ (point " + std::to_string(k) + ")");
+          }
+        }
+      } else {
+        sr.error_at(*pts, "points", std::string("expected an array of [x, y], got ") + type_name(*pts));
+      }
+    } else {
+      sr.missing("points");
+    }
+    if (const toml::node* nrm = sr.node("normals")) {
+      if (const auto* a = nrm->as_array()) {
+        for (std::size_t k = 0; k < a->size(); ++k) {
+          if (auto v = sr.vec2(*a->get(k), indexed(sr.key_path("normals"), k))) {
+            if (length(*v) == 0.0) {
+              sr.error_at(*a->get(k), "normals", "a normal must be non-zero");
+            } else {
+              sd.normals.push_back(normalized(*v));
+            }
+          }
+        }
+        if (sd.normals.size() != sd.points.size()) sr.error_at(*nrm, "normals", "needs one normal per point");
+      } else {
+        sr.error_at(*nrm, "normals", std::string("expected an array of [x, y], got ") + type_name(*nrm));
+      }
+    } else if (sd.points.size() >= 2) {
+      // Default: the left-hand normal of the polyline, averaged at interior points.
+      const std::size_t n = sd.points.size();
+      sd.normals.assign(n, Vec2{});
+      for (std::size_t k = 0; k + 1 < n; ++k) {
+        const Vec2 seg_n = normalized(perp(sd.points[k + 1] - sd.points[k]));
+        sd.normals[k] += seg_n;
+        sd.normals[k + 1] += seg_n;
+      }
+      for (Vec2& v : sd.normals) v = normalized(v);
+    }
+    read_material(sr, sd.material);
+    s.surfaces.push_back(sd);
+  }
+  auto materials = r.tables("materials");
+  for (std::size_t i = 0; i < materials.size(); ++i) {
+    TableReader mr(ctx, *materials[i], indexed("materials", i));
+    MaterialOverride m;
+    mr.read("a", m.a, true);
+    mr.read("b", m.b, true);
+    for (auto [key, field] : {std::pair{"restitution", &m.restitution}, std::pair{"friction", &m.friction},
+                              std::pair{"static_friction", &m.static_friction},
+                              std::pair{"rolling_friction", &m.rolling_friction}}) {
+      double v = 0.0;
+      const bool given = mr.has(key);
+      mr.read_non_negative(key, v);
+      if (given) *field = v;
+    }
+    s.materials.push_back(m);
+  }
+  auto rules = r.tables("collision_matrix");
+  for (std::size_t i = 0; i < rules.size(); ++i) {
+    TableReader cr(ctx, *rules[i], indexed("collision_matrix", i));
+    CollisionRule rule;
+    cr.read("a", rule.a, true);
+    cr.read("b", rule.b, true);
+    if (!cr.has("response")) cr.missing("response");
+    if (auto c = cr.choice("response", {"bounce", "destroy_a", "destroy_b", "destroy_both", "ignore", "event"})) {
+      rule.response = static_cast<CollisionResponse>(*c);
+    }
+    s.collision_matrix.push_back(rule);
+  }
+  auto emitters = r.tables("emitters");
+  for (std::size_t i = 0; i < emitters.size(); ++i) {
+    TableReader er(ctx, *emitters[i], indexed("emitters", i));
+    EmitterDef e;
+    e.line = static_cast<int>(emitters[i]->source().begin.line);
+    e.name = "emitter" + std::to_string(i);
+    er.read("name", e.name);
+    er.read("parent", e.parent, true);
+    if (auto m = er.choice("mode", {"explode", "trail"})) e.mode = *m == 0 ? EmitterMode::Explode : EmitterMode::Trail;
+    er.read_non_negative("at", e.at);
+    er.read_non_negative("rate", e.rate);
+    double count = 0.0;
+    er.read("count", count, "a whole number >= 0", [](double v) { return v >= 0.0 && v == std::floor(v) && v < 1e8; });
+    e.count = static_cast<int>(count);
+    er.read_non_negative("speed", e.speed);
+    er.read("lifetime", e.lifetime, "> 0", [](double v) { return v > 0.0; });
+    er.read("mass", e.mass, "> 0", [](double v) { return v > 0.0; });
+    er.read("destroy_on_collision", e.destroy_on_collision);
+    er.read("gravity", e.gravity);
+    double seed = 1.0;
+    er.read("seed", seed, "a whole number >= 0", [](double v) { return v >= 0.0 && v == std::floor(v); });
+    e.seed = static_cast<std::uint64_t>(seed);
+    if (e.mode == EmitterMode::Explode && e.count == 0) er.error_here("count", "an exploding emitter needs count > 0");
+    if (e.mode == EmitterMode::Trail && e.rate <= 0.0) er.error_here("rate", "a trail emitter needs rate > 0");
+    s.emitters.push_back(e);
+  }
+  if (const toml::table* c = r.subtable("conserves")) {
+    TableReader cr(ctx, *c, "conserves");
+    cr.read("energy", s.conserves.energy);
+    cr.read("linear_momentum", s.conserves.linear_momentum);
+    cr.read("angular_momentum", s.conserves.angular_momentum);
+  }
+  if (const toml::table* e = r.subtable("expect")) read_expect(ctx, *e, s.expect);
+  if (const toml::table* g = r.subtable("gate")) read_gate(ctx, *g, s.gate);
+  for (const EngineFactory& f : engine_registry()) {
+    if (const toml::table* t = r.subtable(f.info.name)) read_engine_options(ctx, *t, f.info, s.engine_options[f.info.name]);
+  }
+  if (s.sample_interval > 0.0 && s.sample_interval < s.dt) {
+    r.error_here("sample_interval", "must be >= dt (" + format_number(s.dt) + ") or 0 for automatic");
+  }
+  r.finish();
+  check_references(ctx, root, s);
+  return s;
+}
+
+}  // namespace
+
+ScenarioLoad parse_scenario(std::string_view text, const std::string& source_name) {
+  Context ctx{source_name, {}};
+  ScenarioLoad out;
+  toml::table root;
+  try {
+    root = toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    ctx.errors.push_back({source_name, static_cast<int>(e.source().begin.line),
+                          static_cast<int>(e.source().begin.column), "", "TOML syntax error: " + std::string(e.description())});
+    out.errors = std::move(ctx.errors);
+    return out;
+  }
+  Scene scene = read_scene(ctx, root);
+  if (ctx.errors.empty()) {
+    out.scene = std::move(scene);
+  } else {
+    std::stable_sort(ctx.errors.begin(), ctx.errors.end(),
+                     [](const Diagnostic& a, const Diagnostic& b) { return a.line < b.line; });
+  }
+  out.errors = std::move(ctx.errors);
+  return out;
+}
+
+ScenarioLoad load_scenario_file(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    ScenarioLoad out;
+    out.errors.push_back({file.string(), 0, 0, "", "cannot open the file"});
+    return out;
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_scenario(ss.str(), file.string());
+}
+
+SuiteLoad load_suite(const std::vector<std::string>& paths) {
+  SuiteLoad out;
+  std::vector<std::filesystem::path> files;
+  for (const std::string& p : paths) {
+    std::error_code ec;
+    const std::filesystem::path path(p);
+    if (std::filesystem::is_directory(path, ec)) {
+      std::vector<std::filesystem::path> found;
+      for (auto it = std::filesystem::recursive_directory_iterator(path, ec);
+           !ec && it != std::filesystem::recursive_directory_iterator(); it.increment(ec)) {
+        if (it->is_regular_file() && it->path().extension() == ".toml") found.push_back(it->path());
+      }
+      std::sort(found.begin(), found.end());
+      if (found.empty()) out.errors.push_back({p, 0, 0, "", "no scenario files (*.toml) in this folder"});
+      files.insert(files.end(), found.begin(), found.end());
+    } else if (std::filesystem::is_regular_file(path, ec)) {
+      files.push_back(path);
+    } else {
+      out.errors.push_back({p, 0, 0, "", "no such file or folder"});
+    }
+  }
+  std::map<std::string, std::string> seen;   // scenario name -> file
+  for (const auto& f : files) {
+    ScenarioLoad one = load_scenario_file(f);
+    out.errors.insert(out.errors.end(), one.errors.begin(), one.errors.end());
+    if (!one.scene) continue;
+    auto [it, fresh] = seen.emplace(one.scene->name, f.string());
+    if (!fresh) {
+      out.errors.push_back({f.string(), 1, 0, "name",
+                            "scenario name \"" + one.scene->name + "\" is already used by " + it->second});
+      continue;
+    }
+    out.scenes.push_back(std::move(*one.scene));
+  }
+  return out;
+}
+
+}  // namespace physval

@@ -1,0 +1,42 @@
+// Holds runs against physics and against each other: conservation drift, divergence
+// from the reference, contact timing, expectations, gates.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "physval/validation/run_record.hpp"
+#include "physval/validation/runner.hpp"
+
+namespace physval {
+
+// The run every engine is held against: a converged run of core (finer step, RK4,
+// exact impacts), checked by running it at two resolutions.
+struct Reference {
+  bool available = false;
+  bool converged = false;
+  std::string reason;               // why not available / not converged
+  double dt = 0.0;                  // the finer of the two resolutions
+  double convergence_error = 0.0;   // max position difference between them, m
+  std::optional<RunRecord> run;     // the finer run
+};
+
+// Builds the reference for `scene` (already effective: dt/duration applied).
+Reference make_reference(const Scene& scene, const RunOptions& options);
+
+// Fills run.metrics and run.checks from the run, the scene and the reference.
+// `enforce_gates`: the scene's [gate] limits count towards pass/fail (physval gate).
+void compare_run(RunRecord& run, const Scene& scene, const Reference& reference, bool enforce_gates);
+
+// The same measures between two engines' runs of one scene.
+struct PairComparison {
+  std::string scenario;
+  std::string a;
+  std::string b;
+  Metrics metrics;   // position_divergence, energy_divergence, linear_momentum_divergence,
+                     // contact_time_error, missed_contacts (in b, of a's), extra_contacts
+};
+PairComparison compare_pair(const RunRecord& a, const RunRecord& b, const Scene& scene);
+
+}  // namespace physval

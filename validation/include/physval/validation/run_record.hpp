@@ -1,0 +1,88 @@
+// What one run of one scenario on one engine produced: sampled states, the contacts
+// it reported, its settings, its timing, and (once compared) its metrics and checks.
+#pragma once
+
+#include <cstddef>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "physval/core/engine.hpp"
+
+namespace physval {
+
+enum class RunStatus { Ok, Diverged, Unsupported, Error };
+const char* run_status_name(RunStatus s);
+
+// Aggregates computed from a state sample and the scene (never from what an engine
+// claims): see conservation.hpp.
+struct Totals {
+  double kinetic = 0.0;
+  double potential = 0.0;      // uniform field + Newtonian
+  Vec2 momentum;               // sum m v of moving bodies
+  double angular_momentum = 0.0;   // about the origin: sum m (x cross v)
+  double energy() const { return kinetic + potential; }
+};
+
+// States sampled at regular times; states[k][i] is body i at time[k].
+struct Series {
+  std::vector<double> time;
+  std::vector<Totals> totals;
+  std::vector<std::vector<BodyState>> states;
+};
+
+struct ContactRecord {
+  std::string a;       // names (bodies, walls, boxes, surfaces)
+  std::string b;
+  double time = 0.0;
+  long step = 0;       // the step the engine reported it in (1-based)
+};
+
+// Apex and orbit probes, sampled every step for the bodies [expect] names.
+struct Probe {
+  std::string body;
+  double max_y = -1e300;
+  double max_y_time = 0.0;
+  double revolutions = 0.0;       // accumulated angle / 2 pi around `around`
+  double last_full_rev_time = 0.0;   // time of the last completed revolution
+  int full_revolutions = 0;
+};
+
+struct Check {
+  std::string what;     // "energy_drift", "expect.final.a.velocity", ...
+  double limit = 0.0;
+  std::optional<double> value;   // nullopt: could not be measured (counts as failed)
+  bool pass = false;
+  bool enforced = true; // false: reported only (a gate limit during `run`)
+};
+
+using Metrics = std::map<std::string, std::optional<double>>;
+
+struct RunRecord {
+  std::string scenario;
+  std::string engine;
+  std::string engine_version;
+  std::string precision;
+  double dt = 0.0;
+  long steps = 0;            // steps actually taken
+  long steps_planned = 0;
+  RunStatus status = RunStatus::Ok;
+  std::string reason;
+  std::optional<double> diverged_at;   // simulated time, s
+  double wall_seconds = 0.0;           // time inside step() only
+  double load_seconds = 0.0;
+  std::vector<Setting> settings;
+  std::vector<std::string> limits_hit;
+  std::vector<BodyMeta> bodies;
+  std::vector<ContactRecord> contacts;
+  std::vector<Probe> probes;
+  Series series;
+  std::vector<BodyState> final_states;
+
+  Metrics metrics;
+  std::vector<Check> checks;
+  bool passed() const;   // status ok (or unsupported) and every enforced check passes
+};
+
+}  // namespace physval

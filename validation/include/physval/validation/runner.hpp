@@ -1,0 +1,45 @@
+// Runs scenarios on engines. Each engine run can happen in a child process, so an
+// engine that crashes or hangs costs only its own run.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "physval/core/engine.hpp"
+#include "physval/validation/run_record.hpp"
+
+namespace physval {
+
+struct RunOptions {
+  std::optional<double> dt;          // overrides the scenario's dt
+  std::optional<double> duration;    // overrides the scenario's duration
+  bool isolate = true;               // run each engine in a child process
+  double timeout_seconds = 0.0;      // per run; 0: none
+  // Bound on stored samples x bodies (memory); the sample interval grows to fit.
+  std::size_t max_sample_states = 4'000'000;
+};
+
+// The scene as it will run: the options' dt and duration applied.
+Scene effective_scene(const Scene& scene, const RunOptions& options);
+
+// How many steps between samples for this scene (from sample_interval, or automatic:
+// about 400 samples, fewer for scenes with many bodies).
+long sample_every(const Scene& scene, std::size_t max_sample_states);
+
+// Runs one engine on one scene in this process. Never throws: failures become
+// status error / diverged with a reason.
+RunRecord run_engine(const Scene& scene, const EngineFactory& engine, const RunOptions& options);
+
+// The same in a child process (when options.isolate), surviving crashes and hangs.
+RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& engine, const RunOptions& options);
+
+// A run that never happened because the engine cannot model the scene.
+RunRecord unsupported_run(const Scene& scene, const EngineInfo& info, const std::vector<std::string>& missing);
+
+// The engines to run a scene on: `wanted` (empty: all in the registry), narrowed by
+// the scene's own `engines` list.
+std::vector<const EngineFactory*> engines_for(const Scene& scene, const std::vector<std::string>& wanted);
+
+}  // namespace physval

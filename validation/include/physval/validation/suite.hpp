@@ -1,0 +1,35 @@
+// A suite run: every scenario on every engine that can model it, compared with the
+// reference and with each other.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "physval/validation/comparator.hpp"
+#include "physval/validation/run_record.hpp"
+#include "physval/validation/runner.hpp"
+
+namespace physval {
+
+struct ScenarioResult {
+  Scene scene;                 // as run (dt and duration overrides applied)
+  Reference reference;
+  std::vector<RunRecord> runs;
+  std::vector<PairComparison> pairs;
+};
+
+struct SuiteResult {
+  std::vector<ScenarioResult> scenarios;
+  bool gates_enforced = false;
+};
+
+using Progress = std::function<void(const std::string& line)>;
+
+SuiteResult run_suite(const std::vector<Scene>& scenes, const std::vector<std::string>& engines,
+                      const RunOptions& options, bool enforce_gates, const Progress& progress = {});
+
+// 0: everything ran and passed; 1: a check failed or a run diverged / errored.
+int suite_exit_status(const SuiteResult& result);
+
+}  // namespace physval
