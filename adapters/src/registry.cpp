@@ -7,14 +7,25 @@
 namespace physval {
 
 const std::vector<EngineFactory>& engine_registry() {
-  static const std::vector<EngineFactory> engines = {
-      core_engine_factory(), box2d_engine_factory(), bullet_engine_factory()};
+  static const std::vector<EngineFactory> engines = [] {
+    std::vector<EngineFactory> all = {core_engine_factory(), box2d_engine_factory(), bullet_engine_factory()};
+    // core, run with RK4 and event-driven impacts, is the reference.
+    all[0].reference_options = {{"integrator", std::string("rk4")}, {"collision", std::string("exact")}};
+    return all;
+  }();
   return engines;
 }
 
 const EngineFactory* find_engine(const std::string& name) {
   for (const EngineFactory& f : engine_registry()) {
     if (f.info.name == name) return &f;
+  }
+  return nullptr;
+}
+
+const EngineFactory* reference_engine() {
+  for (const EngineFactory& f : engine_registry()) {
+    if (!f.reference_options.empty()) return &f;
   }
   return nullptr;
 }

@@ -12,5 +12,7 @@ namespace physval {
 const std::vector<EngineFactory>& engine_registry();
 // nullptr when there is no engine of that name.
 const EngineFactory* find_engine(const std::string& name);
+// The engine whose converged runs serve as the reference (nullptr: none).
+const EngineFactory* reference_engine();
 
 }  // namespace physval

@@ -109,6 +109,10 @@ std::vector<std::string> unsupported_features(const EngineInfo& info, const Scen
 struct EngineFactory {
   EngineInfo info;
   std::function<std::unique_ptr<Engine>()> create;
+  // Options that make this engine a converged reference (finest integrator, exact
+  // impacts); empty when it cannot serve as one. The comparator uses the first engine
+  // of the registry that can.
+  EngineOptions reference_options;
 };
 
 }  // namespace physval
