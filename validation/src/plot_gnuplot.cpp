@@ -1,0 +1,296 @@
+// Renders plot::Figure through gnuplot: one data file (a block per series, selected
+// with `index`), one script, one PNG, all in a private temporary folder; the PNG is
+// then moved into place. Values a log axis cannot show (zero, negative) and non-finite
+// values are left out here, so gnuplot never sees them.
+#include "physval/validation/plot.hpp"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <system_error>
+
+namespace physval::plot {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Point types that read well at ~1000 px: filled circle, square, triangle, diamond,
+// inverted triangle, then open versions.
+constexpr int kPointTypes[] = {7, 5, 9, 13, 11, 6, 4, 8, 12, 10};
+constexpr int kPointTypeCount = static_cast<int>(sizeof(kPointTypes) / sizeof(kPointTypes[0]));
+
+// A gnuplot double-quoted string (backslash escapes processed, "\n" a line break).
+std::string quoted(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '\\': out += "\\\\"; break;
+      case '"': out += "\\\""; break;
+      case '\n': out += "\\n"; break;
+      default: out += c;
+    }
+  }
+  out += '"';
+  return out;
+}
+
+// A POSIX shell single-quoted word.
+std::string shell_quoted(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) {
+    if (c == '\'') {
+      out += "'\\''";
+    } else {
+      out += c;
+    }
+  }
+  out += '\'';
+  return out;
+}
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+bool keep(double v, bool log_axis) { return std::isfinite(v) && (!log_axis || v > 0.0); }
+
+// The points of a series a panel can draw.
+std::vector<std::pair<double, double>> drawable(const Series& s, const Panel& p) {
+  std::vector<std::pair<double, double>> out;
+  const std::size_t n = std::min(s.x.size(), s.y.size());
+  out.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (keep(s.x[i], p.x.log) && keep(s.y[i], p.y.log)) out.emplace_back(s.x[i], s.y[i]);
+  }
+  return out;
+}
+
+struct Extent {
+  double lo = INFINITY;
+  double hi = -INFINITY;
+  bool empty() const { return !(lo <= hi); }
+};
+
+std::string axis_commands(char name, const Axis& axis, const Extent& data) {
+  std::ostringstream os;
+  const std::string a(1, name);
+  os << "set " << a << "label " << quoted(axis.label) << " noenhanced\n";
+  if (axis.log) {
+    os << "set logscale " << a << " 10\n";
+    // Power-of-ten labels only when the axis spans a decade; otherwise plain numbers
+    // (10^{%L} would mislabel tics that are not powers of ten).
+    const double lo = axis.min.value_or(data.lo);
+    const double hi = axis.max.value_or(data.hi);
+    if (!data.empty() && hi / lo >= 10.0) {
+      os << "set format " << a << " \"10^{%L}\"\n";
+    } else {
+      os << "set format " << a << " \"%g\"\n";
+    }
+    os << "set m" << a << "tics 10\n";
+  } else {
+    os << "unset logscale " << a << "\nset format " << a << " \"%g\"\nset m" << a << "tics default\n";
+  }
+  if (!axis.tics.empty()) {
+    os << "set " << a << "tics (";
+    for (std::size_t i = 0; i < axis.tics.size(); ++i) {
+      if (i > 0) os << ", ";
+      os << quoted(axis.tics[i].second) << ' ' << number(axis.tics[i].first);
+    }
+    os << ") noenhanced\n";
+  } else {
+    os << "set " << a << "tics auto enhanced\n";
+  }
+  os << "set " << a << "range [" << (axis.min ? number(*axis.min) : std::string("*")) << ':'
+     << (axis.max ? number(*axis.max) : std::string("*")) << "]\n";
+  return os.str();
+}
+
+std::string style_of(const Series& s) {
+  switch (s.style) {
+    case Style::Lines: return "lines";
+    case Style::Points: return "points";
+    case Style::LinesPoints: return "linespoints";
+  }
+  return "linespoints";
+}
+
+}  // namespace
+
+const std::vector<std::string>& palette() {
+  static const std::vector<std::string> colours = {
+      "#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9",
+      "#8C564B", "#9467BD", "#7F7F7F", "#17BECF", "#BCBD22", "#1F3A93"};
+  return colours;
+}
+
+bool gnuplot_available() {
+  const int rc = std::system("gnuplot --version >/dev/null 2>&1");
+  return rc != -1 && WIFEXITED(rc) && WEXITSTATUS(rc) == 0;
+}
+
+std::string gnuplot_script(const Figure& figure, const fs::path& data_file, const fs::path& png) {
+  std::ostringstream os;
+  os << "set terminal pngcairo enhanced size " << figure.width << ',' << figure.height
+     << " font 'Sans,11' linewidth 1\n";
+  os << "set output " << quoted(png.string()) << "\n";
+  os << "set datafile separator whitespace\n";
+  os << "set grid xtics ytics mxtics mytics lc rgb '#e4e4e4' lw 1, lc rgb '#f2f2f2' lw 1\n";
+  os << "set border lw 1.2\n";
+  os << "set tics out nomirror\n";
+  const bool multi = figure.panels.size() > 1;
+  if (multi) {
+    os << "set multiplot layout " << figure.panels.size() << ",1";
+    if (!figure.title.empty()) os << " title " << quoted(figure.title) << " font ',13' noenhanced";
+    os << "\n";
+  }
+
+  std::size_t block = 0;   // index of the next data block in the data file
+  for (const Panel& panel : figure.panels) {
+    // Automatic colours and markers restart in each panel: series i looks the same
+    // in every panel of a figure.
+    int auto_colour = 0;
+    int auto_point = 0;
+    Extent ex, ey;
+    std::vector<std::vector<std::pair<double, double>>> data;
+    for (const Series& s : panel.series) {
+      data.push_back(drawable(s, panel));
+      for (const auto& [x, y] : data.back()) {
+        ex.lo = std::min(ex.lo, x);
+        ex.hi = std::max(ex.hi, x);
+        ey.lo = std::min(ey.lo, y);
+        ey.hi = std::max(ey.hi, y);
+      }
+    }
+    std::string title = multi ? panel.title
+                              : (figure.title.empty() ? panel.title
+                                                      : (panel.title.empty() ? figure.title
+                                                                             : figure.title + "\n" + panel.title));
+    if (!panel.note.empty()) title += "\n" + panel.note;
+    os << "unset label\n";
+    os << "set title " << quoted(title) << " noenhanced font ',12'\n";
+    os << axis_commands('x', panel.x, ex) << axis_commands('y', panel.y, ey);
+    if (panel.key == "off") {
+      os << "set key off\n";
+    } else {
+      os << "set key " << panel.key << " box opaque samplen 3 spacing 1.15 font ',10' noenhanced\n";
+    }
+    os << (panel.equal_aspect ? "set size ratio -1\n" : "set size noratio\n");
+
+    std::vector<std::string> parts;
+    for (std::size_t i = 0; i < panel.series.size(); ++i) {
+      const Series& s = panel.series[i];
+      const int colour = s.color >= 0 ? s.color : auto_colour++;
+      const int pt = s.point_type >= 0 ? s.point_type : kPointTypes[auto_point++ % kPointTypeCount];
+      if (data[i].empty()) continue;   // nothing drawable: leave it out of the plot
+      std::ostringstream p;
+      p << quoted(data_file.string()) << " index " << block << " using 1:2 with " << style_of(s)
+        << " lc rgb '"
+        << (s.rgb.empty() ? palette()[static_cast<std::size_t>(colour) % palette().size()] : s.rgb) << "'"
+        << " lw " << number(s.line_width) << " dt " << s.dash;
+      if (s.style != Style::Lines) p << " pt " << pt << " ps " << number(s.point_size);
+      if (s.title.empty()) {
+        p << " notitle";
+      } else {
+        p << " title " << quoted(s.title) << " noenhanced";
+      }
+      parts.push_back(p.str());
+      ++block;
+    }
+    if (parts.empty()) {
+      // An empty panel still renders (and says so) rather than failing the figure.
+      os << "unset logscale xy\nset format x \"%g\"\nset format y \"%g\"\n"
+         << "set xrange [0:1]\nset yrange [0:1]\nset key off\n"
+         << "set label 1 \"no data to plot\" at graph 0.5, graph 0.5 center font ',14' noenhanced\n"
+         << "plot 2 notitle\n";
+    } else {
+      os << "plot ";
+      for (std::size_t i = 0; i < parts.size(); ++i) {
+        if (i > 0) os << ", \\\n     ";
+        os << parts[i];
+      }
+      os << "\n";
+    }
+  }
+  if (multi) os << "unset multiplot\n";
+  os << "set output\n";
+  return os.str();
+}
+
+void render_png(const Figure& figure, const fs::path& png) {
+  if (!gnuplot_available()) {
+    throw PlotError("gnuplot is not installed (or not on PATH): the plots need it; on Debian "
+                    "install the gnuplot-nox package");
+  }
+  static std::atomic<unsigned> counter{0};
+  std::random_device rd;
+  const fs::path tmp = fs::temp_directory_path() /
+                       ("physval-plot-" + std::to_string(::getpid()) + "-" +
+                        std::to_string(counter++) + "-" + std::to_string(rd()));
+  fs::create_directories(tmp);
+  struct Cleanup {
+    fs::path dir;
+    ~Cleanup() {
+      std::error_code ec;
+      fs::remove_all(dir, ec);
+    }
+  } cleanup{tmp};
+
+  const fs::path data_file = tmp / "data.txt";
+  const fs::path script_file = tmp / "plot.gp";
+  const fs::path out_png = tmp / "plot.png";
+  const fs::path log_file = tmp / "gnuplot.log";
+  {
+    std::ofstream data(data_file);
+    for (const Panel& panel : figure.panels) {
+      for (const Series& s : panel.series) {
+        const auto points = drawable(s, panel);
+        if (points.empty()) continue;
+        for (const auto& [x, y] : points) {
+          char line[80];
+          std::snprintf(line, sizeof line, "%.17g %.17g\n", x, y);
+          data << line;
+        }
+        data << "\n\n";   // two blank lines end a gnuplot `index` block
+      }
+    }
+    std::ofstream script(script_file);
+    script << gnuplot_script(figure, data_file, out_png);
+    if (!data || !script) throw PlotError("cannot write gnuplot input in " + tmp.string());
+  }
+
+  const std::string command = "gnuplot " + shell_quoted(script_file.string()) + " >" +
+                              shell_quoted(log_file.string()) + " 2>&1";
+  const int rc = std::system(command.c_str());
+  auto gnuplot_log = [&] {
+    std::ifstream in(log_file);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  if (rc == -1 || !WIFEXITED(rc) || WEXITSTATUS(rc) != 0) {
+    throw PlotError("gnuplot failed drawing " + png.string() + ":\n" + gnuplot_log());
+  }
+  std::error_code ec;
+  if (!fs::exists(out_png) || fs::file_size(out_png, ec) == 0) {
+    throw PlotError("gnuplot produced no image for " + png.string() + ":\n" + gnuplot_log());
+  }
+
+  // Into place whole: copy next to the target, then rename over it.
+  if (png.has_parent_path()) fs::create_directories(png.parent_path());
+  const fs::path staged = png.string() + ".tmp";
+  fs::copy_file(out_png, staged, fs::copy_options::overwrite_existing);
+  fs::rename(staged, png);
+}
+
+}  // namespace physval::plot
