@@ -1,1 +1,277 @@
-int main() { return 0; }
+// physval: the command. Exit status 0: everything ran and held; 1: a gate or an
+// expectation failed, or an engine diverged; 2: bad input or usage, nothing was run.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "physval/adapters/registry.hpp"
+#include "physval/validation/console_table.hpp"
+#include "physval/validation/gate.hpp"
+#include "physval/validation/results_json.hpp"
+#include "physval/validation/scenario_loader.hpp"
+#include "physval/validation/suite.hpp"
+
+namespace {
+
+using namespace physval;
+
+constexpr int kExitFailed = 1;
+constexpr int kExitBadInput = 2;
+
+// "1/60", "0.01", "1e-3" -> seconds; nullopt when not a positive finite number.
+std::optional<double> parse_seconds(const std::string& text) {
+  try {
+    const auto slash = text.find('/');
+    std::size_t used = 0;
+    double v;
+    if (slash != std::string::npos) {
+      const double num = std::stod(text.substr(0, slash), &used);
+      if (used != slash) return std::nullopt;
+      const std::string den_text = text.substr(slash + 1);
+      const double den = std::stod(den_text, &used);
+      if (used != den_text.size()) return std::nullopt;
+      v = num / den;
+    } else {
+      v = std::stod(text, &used);
+      if (used != text.size()) return std::nullopt;
+    }
+    if (!std::isfinite(v) || v <= 0.0) return std::nullopt;
+    return v;
+  } catch (...) {
+    return std::nullopt;
+  }
+}
+
+struct CommonOptions {
+  std::vector<std::string> paths;
+  std::vector<std::string> engines;
+  std::string out = "physval-out";
+  std::string dt;
+  std::string duration;
+  bool no_isolate = false;
+  double timeout = 0.0;
+  bool quiet = false;
+};
+
+void add_common(CLI::App* cmd, CommonOptions& o) {
+  cmd->add_option("PATH", o.paths, "scenario files (*.toml) or folders of them (searched recursively)")->required();
+  cmd->add_option("--engines", o.engines, "engines to run, comma-separated (default: all)")->delimiter(',');
+  cmd->add_option("--out", o.out, "output folder for results.json and series/")->capture_default_str();
+  cmd->add_option("--dt", o.dt, "override every scenario's step, seconds (1/60 or 0.0166)");
+  cmd->add_option("--duration", o.duration, "override every scenario's duration, seconds");
+  cmd->add_flag("--no-isolate", o.no_isolate, "run engines in this process (debugging; a crash then ends physval)");
+  cmd->add_option("--timeout", o.timeout, "seconds a single engine run may take before it is stopped (0: no limit)");
+  cmd->add_flag("--quiet", o.quiet, "print only the summary line");
+}
+
+int bad_input(const std::string& message) {
+  std::cerr << "physval: " << message << '\n';
+  return kExitBadInput;
+}
+
+// Loads and validates; prints every error. Returns the scenes or nullopt.
+std::optional<std::vector<Scene>> load_or_report(const std::vector<std::string>& paths) {
+  SuiteLoad load = load_suite(paths);
+  for (const Diagnostic& d : load.errors) std::cerr << d.str() << '\n';
+  if (!load.errors.empty()) {
+    std::cerr << "physval: " << load.errors.size() << " error" << (load.errors.size() == 1 ? "" : "s")
+              << " in the scenario files; nothing was run\n";
+    return std::nullopt;
+  }
+  return std::move(load.scenes);
+}
+
+int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, const std::string& baseline_path,
+                double baseline_factor) {
+  RunOptions options;
+  if (!o.dt.empty()) {
+    options.dt = parse_seconds(o.dt);
+    if (!options.dt) return bad_input("--dt: expected a positive number of seconds such as 1/60 or 0.01, got \"" + o.dt + "\"");
+  }
+  if (!o.duration.empty()) {
+    options.duration = parse_seconds(o.duration);
+    if (!options.duration) return bad_input("--duration: expected a positive number of seconds, got \"" + o.duration + "\"");
+  }
+  for (const std::string& e : o.engines) {
+    if (find_engine(e) == nullptr) return bad_input("--engines: no engine named \"" + e + "\" (see `physval engines`)");
+  }
+  if (o.timeout < 0.0) return bad_input("--timeout must be >= 0");
+  options.isolate = !o.no_isolate;
+  options.timeout_seconds = o.timeout;
+  nlohmann::json baseline;
+  if (!baseline_path.empty()) {
+    std::ifstream in(baseline_path);
+    if (!in) return bad_input(baseline_path + ": cannot open the baseline");
+    try {
+      baseline = nlohmann::json::parse(in);
+    } catch (const std::exception& e) {
+      return bad_input(baseline_path + ": not a results.json: " + e.what());
+    }
+    if (!baseline.contains("runs")) return bad_input(baseline_path + ": not a results.json (no \"runs\")");
+  }
+  if (baseline_factor < 1.0) return bad_input("--baseline-factor must be >= 1");
+  auto scenes = load_or_report(o.paths);
+  if (!scenes) return kExitBadInput;
+
+  const bool tty = ::isatty(2) != 0;
+  Progress progress;
+  if (tty && !o.quiet) {
+    progress = [](const std::string& line) { std::cerr << "\r\033[K  running " << line << std::flush; };
+  }
+  SuiteResult result = run_suite(*scenes, o.engines, options, gate, progress);
+  if (progress) std::cerr << "\r\033[K" << std::flush;
+  if (!baseline_path.empty()) {
+    const int matched = apply_baseline(result, baseline, baseline_factor);
+    std::cout << "baseline: " << matched << " runs matched in " << baseline_path << " (regression factor "
+              << baseline_factor << ")\n";
+  }
+  if (o.quiet) {
+    std::ostringstream sink;
+    print_suite_table(sink, result);
+    const std::string text = sink.str();
+    const auto last = text.rfind('\n', text.size() - 2);
+    std::cout << text.substr(last == std::string::npos ? 0 : last + 1);
+  } else {
+    print_suite_table(std::cout, result);
+  }
+  try {
+    write_results(o.out, result);
+    std::cout << "results: " << (std::filesystem::path(o.out) / "results.json").string() << '\n';
+    if (!junit.empty()) {
+      write_file_atomically(junit, junit_xml(result));
+      std::cout << "junit: " << junit << '\n';
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "physval: could not write the results: " << e.what() << '\n';
+    return kExitBadInput;
+  }
+  return suite_exit_status(result);
+}
+
+void print_engines(bool as_json) {
+  if (as_json) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const EngineFactory& f : engine_registry()) {
+      nlohmann::json features = nlohmann::json::array();
+      for (Feature ft : f.info.features) features.push_back(feature_name(ft));
+      nlohmann::json options = nlohmann::json::array();
+      for (const OptionSpec& s : f.info.options) {
+        options.push_back({{"key", s.key}, {"type", option_type_name(s.default_value)},
+                           {"default", option_value_to_string(s.default_value)}, {"choices", s.choices}, {"doc", s.doc}});
+      }
+      out.push_back({{"name", f.info.name}, {"version", f.info.version}, {"precision", precision_name(f.info.precision)},
+                     {"summary", f.info.summary}, {"features", features}, {"options", options},
+                     {"reference", !f.reference_options.empty()}});
+    }
+    std::cout << out.dump(2) << '\n';
+    return;
+  }
+  for (const EngineFactory& f : engine_registry()) {
+    std::cout << f.info.name << "  " << f.info.version << "  " << precision_name(f.info.precision)
+              << (f.reference_options.empty() ? "" : "  (reference engine)") << "\n  " << f.info.summary << "\n  models:";
+    std::size_t col = 10;
+    for (Feature ft : f.info.features) {
+      const std::string name = feature_name(ft);
+      if (col + name.size() + 1 > 96) {
+        std::cout << "\n         ";
+        col = 9;
+      }
+      std::cout << ' ' << name;
+      col += name.size() + 1;
+    }
+    std::vector<std::string> lacks;
+    for (int i = 0; i < static_cast<int>(Feature::Count); ++i) {
+      const auto ft = static_cast<Feature>(i);
+      if (std::find(f.info.features.begin(), f.info.features.end(), ft) == f.info.features.end()) {
+        lacks.push_back(feature_name(ft));
+      }
+    }
+    if (!lacks.empty()) {
+      std::cout << "\n  cannot model:";
+      for (const std::string& l : lacks) std::cout << ' ' << l;
+    }
+    std::cout << "\n  options ([" << f.info.name << "] in a scenario):\n";
+    for (const OptionSpec& s : f.info.options) {
+      std::cout << "    " << s.key << " = " << option_value_to_string(s.default_value) << "  (" << option_type_name(s.default_value);
+      if (!s.choices.empty()) {
+        std::cout << ":";
+        for (std::size_t i = 0; i < s.choices.size(); ++i) std::cout << (i ? "|" : " ") << s.choices[i];
+      }
+      std::cout << ")  " << s.doc << '\n';
+    }
+    std::cout << '\n';
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"physval: runs 2-D physics scenarios on several engines and says where they disagree and by how much"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("physval ") + PHYSVAL_VERSION);
+
+  CommonOptions run_opts;
+  bool run_report = false;
+  auto* run = app.add_subcommand("run", "run scenarios on every engine that can model them and compare the runs");
+  add_common(run, run_opts);
+  run->add_flag("--report", run_report, "also write DIR/report.html with plots");
+
+  CommonOptions gate_opts;
+  std::string junit, baseline;
+  double baseline_factor = 2.0;
+  auto* gate = app.add_subcommand("gate", "`run` with the scenarios' [gate] limits enforced (exit 1 on any failure)");
+  add_common(gate, gate_opts);
+  gate->add_option("--junit", junit, "write JUnit XML here: one test case per scenario and engine");
+  gate->add_option("--baseline", baseline, "an earlier results.json: fail on a regression beyond --baseline-factor");
+  gate->add_option("--baseline-factor", baseline_factor, "how much worse than the baseline an error metric may get")
+      ->capture_default_str();
+
+  std::vector<std::string> check_paths;
+  auto* check = app.add_subcommand("check", "parse and validate scenario files; runs nothing");
+  check->add_option("PATH", check_paths, "scenario files or folders")->required();
+
+  bool engines_json = false;
+  auto* engines = app.add_subcommand("engines", "each engine, its version, precision, options and what it can model");
+  engines->add_flag("--json", engines_json, "print as JSON");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : kExitBadInput;
+  }
+
+  try {
+    if (*check) {
+      auto scenes = load_or_report(check_paths);
+      if (!scenes) return kExitBadInput;
+      for (const Scene& s : *scenes) {
+        std::cout << "ok  " << s.name << "  (" << s.source_file << ": " << s.bodies.size() << " bodies, "
+                  << s.walls.size() + s.boxes.size() + s.surfaces.size() << " barriers, " << s.steps() << " steps)\n";
+      }
+      std::cout << scenes->size() << " scenario" << (scenes->size() == 1 ? "" : "s") << " valid\n";
+      return 0;
+    }
+    if (*engines) {
+      print_engines(engines_json);
+      return 0;
+    }
+    if (*run) {
+      const int status = run_or_gate(run_opts, false, "", "", 2.0);
+      (void)run_report;
+      return status;
+    }
+    if (*gate) return run_or_gate(gate_opts, true, junit, baseline, baseline_factor);
+  } catch (const std::exception& e) {
+    std::cerr << "physval: " << e.what() << '\n';
+    return kExitBadInput;
+  }
+  return kExitBadInput;
+}

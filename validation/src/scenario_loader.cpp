@@ -11,7 +11,7 @@
 #include <set>
 #include <sstream>
 
-#include <toml++/toml.hpp>
+#include <toml++/toml.h>
 
 #include "physval/adapters/registry.hpp"
 #include "physval/validation/metric_names.hpp"

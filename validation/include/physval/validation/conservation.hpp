@@ -1,0 +1,40 @@
+// What a scene conserves, and the totals and scales to measure it with. Everything is
+// computed from sampled states and the scene, never from what an engine reports.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "physval/core/engine.hpp"
+#include "physval/validation/run_record.hpp"
+
+namespace physval {
+
+// Kinetic energy, potential energy (uniform field: -m g.x; Newtonian: -G mi mj / r),
+// linear momentum, angular momentum about the origin, over live moving bodies.
+Totals compute_totals(const Scene& scene, const std::vector<BodyMeta>& bodies,
+                      const std::vector<BodyState>& states);
+
+struct Conserved {
+  bool energy = false;
+  bool linear_momentum = false;
+  bool angular_momentum = false;
+  std::string energy_why;     // the rule that decided, for the README and reports
+  std::string momentum_why;
+};
+
+// The rules (README, "Conservation"): see conservation.cpp. A scenario's
+// [conserves] table overrides each.
+Conserved conserved_quantities(const Scene& scene);
+
+// Characteristic values of a scene that drifts and divergences are divided by. None
+// of them can be near zero while the scene moves (a resting pile's energy can).
+struct Scales {
+  double length = 1.0;            // m: the extent of bodies and barriers
+  double energy = 1.0;            // J: KE0 + M |g| L + |U_newton(0)|
+  double momentum = 1.0;          // kg m/s: max(sum m |v0|, sqrt(2 M E))
+  double angular_momentum = 1.0;  // kg m^2/s: sum m |x0| |v0| + P L
+};
+Scales characteristic_scales(const Scene& scene);
+
+}  // namespace physval

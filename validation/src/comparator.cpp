@@ -1,0 +1,369 @@
+// The comparator: every figure here is computed from sampled states and the scene.
+// Formulas and scales are documented in the README ("Metrics").
+#include "physval/validation/comparator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "physval/adapters/registry.hpp"
+#include "physval/validation/conservation.hpp"
+#include "physval/validation/metric_names.hpp"
+
+namespace physval {
+
+namespace {
+
+// Sample k of `a` paired with the sample of `b` at the same time (or -1).
+std::vector<long> align_samples(const Series& a, const Series& b, double tolerance) {
+  std::vector<long> out(a.time.size(), -1);
+  std::size_t j = 0;
+  for (std::size_t k = 0; k < a.time.size(); ++k) {
+    const double t = a.time[k];
+    while (j + 1 < b.time.size() && b.time[j + 1] <= t + tolerance) ++j;
+    if (j < b.time.size() && std::abs(b.time[j] - t) <= tolerance) out[k] = static_cast<long>(j);
+  }
+  return out;
+}
+
+struct SeriesDivergence {
+  std::optional<double> position_max, position_rms;
+  std::optional<double> energy_max, energy_rms;
+  std::optional<double> momentum_max, momentum_rms;
+  std::optional<double> first_energy_excess_time;   // first t where |dE| > runaway limit
+};
+
+SeriesDivergence series_divergence(const Series& run, const Series& ref, double tolerance, const Scales& scales,
+                                   double energy_runaway) {
+  SeriesDivergence d;
+  const std::vector<long> pairs = align_samples(run, ref, tolerance);
+  double pmax = 0.0, psum = 0.0, emax = 0.0, esum = 0.0, mmax = 0.0, msum = 0.0;
+  std::size_t pn = 0, n = 0;
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    if (pairs[k] < 0) continue;
+    const auto j = static_cast<std::size_t>(pairs[k]);
+    const std::vector<BodyState>& sa = run.states[k];
+    const std::vector<BodyState>& sb = ref.states[j];
+    const std::size_t bodies = std::min(sa.size(), sb.size());
+    for (std::size_t i = 0; i < bodies; ++i) {
+      if (!sa[i].alive || !sb[i].alive) continue;
+      const double e = length(sa[i].position - sb[i].position);
+      pmax = std::max(pmax, e);
+      psum += e * e;
+      ++pn;
+    }
+    const double de = std::abs(run.totals[k].energy() - ref.totals[j].energy()) / scales.energy;
+    const double dm = length(run.totals[k].momentum - ref.totals[j].momentum) / scales.momentum;
+    if (de > energy_runaway && !d.first_energy_excess_time) d.first_energy_excess_time = run.time[k];
+    emax = std::max(emax, de);
+    esum += de * de;
+    mmax = std::max(mmax, dm);
+    msum += dm * dm;
+    ++n;
+  }
+  if (pn > 0) {
+    d.position_max = pmax;
+    d.position_rms = std::sqrt(psum / static_cast<double>(pn));
+  }
+  if (n > 0) {
+    d.energy_max = emax;
+    d.energy_rms = std::sqrt(esum / static_cast<double>(n));
+    d.momentum_max = mmax;
+    d.momentum_rms = std::sqrt(msum / static_cast<double>(n));
+  }
+  return d;
+}
+
+std::pair<std::string, std::string> pair_key(const std::string& a, const std::string& b) {
+  return a < b ? std::pair{a, b} : std::pair{b, a};
+}
+
+struct ContactMatch {
+  std::optional<double> max_error;   // s, over matched contacts
+  int matched = 0;
+  int missed = 0;                    // reference contacts with no match in the run
+  int extra = 0;                     // run contacts with no match in the reference
+  std::vector<std::optional<double>> per_reference;   // error of each reference contact (nullopt: missed)
+};
+
+// Matches contact-begin events pair by pair: each reference contact takes the
+// earliest unmatched run contact of the same pair within `window` seconds.
+ContactMatch match_contacts(const std::vector<ContactRecord>& run, const std::vector<ContactRecord>& ref,
+                            double window) {
+  ContactMatch m;
+  std::vector<bool> used(run.size(), false);
+  m.per_reference.resize(ref.size());
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    const auto key = pair_key(ref[i].a, ref[i].b);
+    std::optional<std::size_t> best;
+    for (std::size_t j = 0; j < run.size(); ++j) {
+      if (used[j] || pair_key(run[j].a, run[j].b) != key) continue;
+      if (std::abs(run[j].time - ref[i].time) <= window) {
+        best = j;
+        break;
+      }
+      if (run[j].time > ref[i].time + window) break;
+    }
+    if (best) {
+      used[*best] = true;
+      const double e = std::abs(run[*best].time - ref[i].time);
+      m.per_reference[i] = e;
+      m.max_error = std::max(m.max_error.value_or(0.0), e);
+      ++m.matched;
+    } else {
+      ++m.missed;
+    }
+  }
+  m.extra = static_cast<int>(std::count(used.begin(), used.end(), false));
+  return m;
+}
+
+double contact_window(double dt) { return std::max(5.0 * dt, 0.05); }
+
+std::string fmt(double v) {
+  std::ostringstream os;
+  os.precision(4);
+  os << v;
+  return os.str();
+}
+
+void add_check(RunRecord& run, const std::string& what, double limit, std::optional<double> value, bool enforced) {
+  Check c;
+  c.what = what;
+  c.limit = limit;
+  c.value = value;
+  c.pass = value.has_value() && std::isfinite(*value) && *value <= limit;
+  c.enforced = enforced;
+  run.checks.push_back(c);
+}
+
+void check_expectations(RunRecord& run, const Scene& scene) {
+  const Expectations& e = scene.expect;
+  const double default_time_tol = 2.0 * scene.dt + 1e-9;
+  auto contact_error = [&](const ExpectedContact& c, std::size_t nth) -> std::optional<double> {
+    std::size_t seen = 0;
+    const auto key = pair_key(c.a, c.b);
+    for (const ContactRecord& r : run.contacts) {
+      if (pair_key(r.a, r.b) != key) continue;
+      if (seen++ == nth) return std::abs(r.time - c.time);
+    }
+    return std::nullopt;
+  };
+  if (e.first_contact) {
+    add_check(run, "expect.first_contact(" + e.first_contact->a + "," + e.first_contact->b + ")",
+              e.first_contact->tolerance.value_or(default_time_tol), contact_error(*e.first_contact, 0), false);
+  }
+  if (!e.contacts.empty()) {
+    std::vector<ContactRecord> expected;
+    for (const ExpectedContact& c : e.contacts) expected.push_back({c.a, c.b, c.time, 0});
+    const ContactMatch m = match_contacts(run.contacts, expected, contact_window(scene.dt));
+    for (std::size_t i = 0; i < e.contacts.size(); ++i) {
+      add_check(run, "expect.contacts[" + std::to_string(i) + "](" + e.contacts[i].a + "," + e.contacts[i].b + ")",
+                e.contacts[i].tolerance.value_or(default_time_tol), m.per_reference[i], false);
+    }
+  }
+  for (const ExpectedFinal& f : e.final_states) {
+    const int i = scene.body_index(f.body);
+    const bool have = i >= 0 && static_cast<std::size_t>(i) < run.final_states.size() &&
+                      run.status == RunStatus::Ok;
+    if (f.velocity) {
+      add_check(run, "expect.final." + f.body + ".velocity", f.tolerance.value_or(1e-6),
+                have ? std::optional<double>(length(run.final_states[static_cast<std::size_t>(i)].velocity - *f.velocity))
+                     : std::nullopt,
+                false);
+    }
+    if (f.position) {
+      add_check(run, "expect.final." + f.body + ".position", f.tolerance.value_or(1e-6),
+                have ? std::optional<double>(length(run.final_states[static_cast<std::size_t>(i)].position - *f.position))
+                     : std::nullopt,
+                false);
+    }
+  }
+  for (const ExpectedApex& a : e.apex) {
+    const Probe* p = nullptr;
+    for (const Probe& pr : run.probes) if (pr.body == a.body) p = &pr;
+    add_check(run, "expect.apex." + a.body + ".height", a.tolerance.value_or(1e-3),
+              p ? std::optional<double>(std::abs(p->max_y - a.height)) : std::nullopt, false);
+    if (a.time) {
+      add_check(run, "expect.apex." + a.body + ".time", a.tolerance.value_or(default_time_tol),
+                p ? std::optional<double>(std::abs(p->max_y_time - *a.time)) : std::nullopt, false);
+    }
+  }
+  for (const ExpectedPeriod& pe : e.period) {
+    const Probe* p = nullptr;
+    for (const Probe& pr : run.probes) if (pr.body == pe.body) p = &pr;
+    std::optional<double> rel;
+    if (p && p->full_revolutions > 0) {
+      const double measured = p->last_full_rev_time / p->full_revolutions;
+      rel = std::abs(measured - pe.period) / pe.period;
+    }
+    add_check(run, "expect.period." + pe.body + " (relative)", pe.tolerance.value_or(1e-3), rel, false);
+  }
+}
+
+}  // namespace
+
+Reference make_reference(const Scene& scene, const RunOptions& options) {
+  Reference ref;
+  const EngineFactory* engine = reference_engine();
+  if (engine == nullptr) {
+    ref.reason = "no engine can serve as the reference";
+    return ref;
+  }
+  const std::vector<std::string> missing = unsupported_features(engine->info, scene);
+  if (!missing.empty()) {
+    ref.reason = "the reference engine cannot model " + missing.front();
+    return ref;
+  }
+  // Refine the step 8x (4x for the check), less for large scenes to bound the cost.
+  int refine = 8;
+  const double body_steps = static_cast<double>(std::max<std::size_t>(1, scene.bodies.size())) * scene.steps();
+  while (refine > 2 && body_steps * refine > 4e7) refine /= 2;
+  const long every = sample_every(scene, options.max_sample_states);
+  auto variant = [&](int factor) {
+    Scene s = scene;
+    s.dt = scene.dt / factor;
+    s.sample_interval = static_cast<double>(every) * scene.dt;
+    for (const auto& [k, v] : engine->reference_options) s.engine_options[engine->info.name][k] = v;
+    return s;
+  };
+  RunOptions ro = options;
+  ro.max_sample_states = static_cast<std::size_t>(-1);
+  const Scene fine = variant(refine);
+  const Scene coarse = variant(refine / 2);
+  RunRecord fine_run = run_engine_isolated(fine, *engine, ro);
+  RunRecord coarse_run = run_engine_isolated(coarse, *engine, ro);
+  ref.dt = fine.dt;
+  if (fine_run.status != RunStatus::Ok || coarse_run.status != RunStatus::Ok) {
+    const RunRecord& bad = fine_run.status != RunStatus::Ok ? fine_run : coarse_run;
+    ref.reason = std::string("the reference run ") + run_status_name(bad.status) + ": " + bad.reason;
+    return ref;
+  }
+  ref.available = true;
+  const Scales scales = characteristic_scales(scene);
+  const SeriesDivergence d = series_divergence(fine_run.series, coarse_run.series, 0.5 * coarse.dt, scales, 1e300);
+  ref.convergence_error = d.position_max.value_or(0.0);
+  // Size of the motion: the scene's extent or the farthest any body travels.
+  double travel = scales.length;
+  for (std::size_t k = 0; k < fine_run.series.states.size(); ++k) {
+    for (std::size_t i = 0; i < fine_run.series.states[k].size() && i < scene.bodies.size(); ++i) {
+      travel = std::max(travel, length(fine_run.series.states[k][i].position - scene.bodies[i].position));
+    }
+  }
+  const double tolerance = 1e-6 * travel + 1e-9;
+  ref.converged = ref.convergence_error <= tolerance;
+  if (!ref.converged) {
+    ref.reason = "not converged: runs at dt/" + std::to_string(refine) + " and dt/" + std::to_string(refine / 2) +
+                 " differ by " + fmt(ref.convergence_error) + " m (limit " + fmt(tolerance) + " m)";
+  }
+  ref.run = std::move(fine_run);
+  return ref;
+}
+
+void compare_run(RunRecord& run, const Scene& scene, const Reference& reference, bool enforce_gates) {
+  run.metrics.clear();
+  run.checks.clear();
+  for (std::string_view name : kMetricNames) run.metrics[std::string(name)] = std::nullopt;
+  if (run.status == RunStatus::Unsupported || run.status == RunStatus::Error) return;
+  run.metrics["wall_seconds"] = run.wall_seconds;
+
+  const Conserved conserved = conserved_quantities(scene);
+  const Scales scales = characteristic_scales(scene);
+  const Series& s = run.series;
+  if (!s.totals.empty()) {
+    const Totals& t0 = s.totals.front();
+    double de = 0.0, dp = 0.0, dl = 0.0;
+    std::optional<double> runaway_at;
+    for (std::size_t k = 0; k < s.totals.size(); ++k) {
+      const double e = std::abs(s.totals[k].energy() - t0.energy()) / scales.energy;
+      if (std::isnan(e)) continue;
+      de = std::max(de, e);
+      dp = std::max(dp, length(s.totals[k].momentum - t0.momentum) / scales.momentum);
+      dl = std::max(dl, std::abs(s.totals[k].angular_momentum - t0.angular_momentum) / scales.angular_momentum);
+      if (conserved.energy && e > 1.0 && !runaway_at) runaway_at = s.time[k];
+    }
+    if (conserved.energy) run.metrics["energy_drift"] = de;
+    if (conserved.linear_momentum) run.metrics["linear_momentum_drift"] = dp;
+    if (conserved.angular_momentum) run.metrics["angular_momentum_drift"] = dl;
+    if (runaway_at && run.status == RunStatus::Ok) {
+      run.status = RunStatus::Diverged;
+      run.diverged_at = runaway_at;
+      run.reason = "energy ran away: it changed by " + fmt(de) + " x the scene's energy scale";
+    }
+  }
+
+  // Divergence from a converged reference.
+  if (reference.available && reference.converged && reference.run) {
+    const double tol = 0.5 * std::min(run.dt, reference.dt);
+    const SeriesDivergence d = series_divergence(s, reference.run->series, tol, scales, 10.0);
+    run.metrics["position_divergence"] = d.position_max;
+    run.metrics["position_divergence_rms"] = d.position_rms;
+    run.metrics["energy_divergence"] = d.energy_max;
+    run.metrics["energy_divergence_rms"] = d.energy_rms;
+    run.metrics["linear_momentum_divergence"] = d.momentum_max;
+    run.metrics["linear_momentum_divergence_rms"] = d.momentum_rms;
+    if (d.first_energy_excess_time && run.status == RunStatus::Ok && !conserved.energy) {
+      run.status = RunStatus::Diverged;
+      run.diverged_at = d.first_energy_excess_time;
+      run.reason = "energy ran away from the reference by more than 10 x the scene's energy scale";
+    }
+  }
+
+  // Contact timing: against [expect] contacts when given, else the reference's.
+  std::optional<std::vector<ContactRecord>> ref_contacts;
+  if (!scene.expect.contacts.empty()) {
+    ref_contacts.emplace();
+    for (const ExpectedContact& c : scene.expect.contacts) ref_contacts->push_back({c.a, c.b, c.time, 0});
+  } else if (reference.available && reference.converged && reference.run) {
+    ref_contacts = reference.run->contacts;
+  }
+  if (!run.contacts.empty()) run.metrics["first_contact_time"] = run.contacts.front().time;
+  if (ref_contacts) {
+    const ContactMatch m = match_contacts(run.contacts, *ref_contacts, contact_window(run.dt));
+    run.metrics["contact_time_error"] = m.max_error;
+    if (m.max_error) run.metrics["contact_time_error_steps"] = *m.max_error / run.dt;
+    run.metrics["missed_contacts"] = m.missed;
+    run.metrics["extra_contacts"] = m.extra;
+  }
+
+  check_expectations(run, scene);
+  int failures = 0;
+  for (const Check& c : run.checks) failures += c.pass ? 0 : 1;
+  if (!scene.expect.empty()) run.metrics["expectation_failures"] = failures;
+
+  // Limits: [gate] merged with [gate.<engine>]. Expectation failures are always
+  // enforced (allowed count 0 unless the gate says otherwise); other limits only when
+  // the gate is enforced.
+  std::map<std::string, double> limits = scene.gate.limits;
+  if (auto it = scene.gate.per_engine.find(run.engine); it != scene.gate.per_engine.end()) {
+    for (const auto& [k, v] : it->second) limits[k] = v;
+  }
+  if (!scene.expect.empty()) {
+    const double allowed = limits.count("expectation_failures") ? limits["expectation_failures"] : 0.0;
+    add_check(run, "expectation_failures", allowed, static_cast<double>(failures), true);
+  }
+  for (const auto& [metric, limit] : limits) {
+    if (metric == "expectation_failures") continue;
+    add_check(run, metric, limit, run.metrics[metric], enforce_gates);
+  }
+}
+
+PairComparison compare_pair(const RunRecord& a, const RunRecord& b, const Scene& scene) {
+  PairComparison pc;
+  pc.scenario = scene.name;
+  pc.a = a.engine;
+  pc.b = b.engine;
+  const Scales scales = characteristic_scales(scene);
+  const SeriesDivergence d = series_divergence(b.series, a.series, 0.5 * std::min(a.dt, b.dt), scales, 1e300);
+  pc.metrics["position_divergence"] = d.position_max;
+  pc.metrics["energy_divergence"] = d.energy_max;
+  pc.metrics["linear_momentum_divergence"] = d.momentum_max;
+  const ContactMatch m = match_contacts(b.contacts, a.contacts, contact_window(std::max(a.dt, b.dt)));
+  pc.metrics["contact_time_error"] = m.max_error;
+  pc.metrics["missed_contacts"] = m.missed;
+  pc.metrics["extra_contacts"] = m.extra;
+  return pc;
+}
+
+}  // namespace physval

@@ -1,0 +1,143 @@
+#include "physval/validation/conservation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "physval/core/forces.hpp"
+
+namespace physval {
+
+Totals compute_totals(const Scene& scene, const std::vector<BodyMeta>& bodies,
+                      const std::vector<BodyState>& states) {
+  Totals t;
+  const std::size_t n = std::min(bodies.size(), states.size());
+  const Vec2 g = scene.world.gravity;
+  for (std::size_t i = 0; i < n; ++i) {
+    const BodyState& s = states[i];
+    const BodyMeta& b = bodies[i];
+    if (!s.alive || b.is_static) continue;
+    t.kinetic += 0.5 * b.mass * length_squared(s.velocity);
+    t.potential -= b.mass * dot(g, s.position);
+    t.momentum += b.mass * s.velocity;
+    t.angular_momentum += b.mass * cross(s.position, s.velocity);
+  }
+  if (scene.world.newtonian) {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!states[i].alive) continue;
+      for (std::size_t j = i + 1; j < n; ++j) {
+        if (!states[j].alive) continue;
+        if (bodies[i].is_static && bodies[j].is_static) continue;
+        // A static body's mass still attracts: scene bodies carry it in the scene.
+        const double mi = bodies[i].is_static && i < scene.bodies.size() ? scene.bodies[i].mass : bodies[i].mass;
+        const double mj = bodies[j].is_static && j < scene.bodies.size() ? scene.bodies[j].mass : bodies[j].mass;
+        t.potential += newtonian_potential(scene.world.G, scene.world.softening, mi, mj, states[i].position,
+                                           states[j].position);
+      }
+    }
+  }
+  return t;
+}
+
+Conserved conserved_quantities(const Scene& scene) {
+  Conserved c;
+  const bool has_barriers = !scene.walls.empty() || !scene.boxes.empty() || !scene.surfaces.empty() ||
+                            std::any_of(scene.bodies.begin(), scene.bodies.end(), [](const BodyDef& b) { return b.is_static; });
+  const bool field = scene.world.gravity.x != 0.0 || scene.world.gravity.y != 0.0;
+  bool drag = false, thrust = false, friction = false, inelastic = false;
+  for (const BodyDef& b : scene.bodies) {
+    drag = drag || b.drag_linear > 0.0 || b.drag_quadratic > 0.0;
+    thrust = thrust || b.thrust.enabled();
+    friction = friction || b.friction > 0.0 || b.static_friction > 0.0 || b.rolling_friction > 0.0;
+    inelastic = inelastic || b.restitution < 1.0;
+  }
+  auto static_material = [&](const StaticMaterial& m) {
+    friction = friction || m.friction > 0.0 || m.static_friction > 0.0 || m.rolling_friction > 0.0;
+    inelastic = inelastic || m.restitution < 1.0;
+  };
+  for (const WallDef& w : scene.walls) static_material(w.material);
+  for (const BoxDef& w : scene.boxes) static_material(w.material);
+  for (const SurfaceDef& w : scene.surfaces) static_material(w.material);
+  for (const MaterialOverride& m : scene.materials) {
+    friction = friction || m.friction.value_or(0.0) > 0.0 || m.rolling_friction.value_or(0.0) > 0.0;
+    inelastic = inelastic || m.restitution.value_or(1.0) < 1.0;
+  }
+  const bool particles = !scene.emitters.empty();
+  const bool destroys = std::any_of(scene.collision_matrix.begin(), scene.collision_matrix.end(), [](const CollisionRule& r) {
+    return r.response == CollisionResponse::DestroyA || r.response == CollisionResponse::DestroyB ||
+           r.response == CollisionResponse::DestroyBoth;
+  });
+
+  if (has_barriers) c.momentum_why = "barriers or static bodies push";
+  else if (field) c.momentum_why = "a uniform field pulls";
+  else if (drag) c.momentum_why = "drag";
+  else if (thrust) c.momentum_why = "thrust";
+  else if (particles) c.momentum_why = "particles are emitted and die";
+  else if (destroys) c.momentum_why = "the collision matrix destroys bodies";
+  else c.momentum_why = "no external force";
+  c.linear_momentum = c.momentum_why == "no external force";
+  // Contact impulses act along the line through both centres at the contact point,
+  // and friction impulses at that same point: about the origin they cancel too.
+  c.angular_momentum = c.linear_momentum;
+
+  if (friction) c.energy_why = "friction";
+  else if (drag) c.energy_why = "drag";
+  else if (thrust) c.energy_why = "thrust";
+  else if (inelastic) c.energy_why = "restitution below 1";
+  else if (particles) c.energy_why = "particles are emitted and die";
+  else if (destroys) c.energy_why = "the collision matrix destroys bodies";
+  else c.energy_why = "elastic, frictionless, no drag or thrust";
+  c.energy = c.energy_why == "elastic, frictionless, no drag or thrust";
+
+  if (scene.conserves.energy) {
+    c.energy = *scene.conserves.energy;
+    c.energy_why = "declared by the scenario";
+  }
+  if (scene.conserves.linear_momentum) {
+    c.linear_momentum = *scene.conserves.linear_momentum;
+    c.momentum_why = "declared by the scenario";
+  }
+  if (scene.conserves.angular_momentum) c.angular_momentum = *scene.conserves.angular_momentum;
+  return c;
+}
+
+Scales characteristic_scales(const Scene& scene) {
+  Scales s;
+  Vec2 lo{1e300, 1e300}, hi{-1e300, -1e300};
+  auto extend = [&](Vec2 p, double r) {
+    lo.x = std::min(lo.x, p.x - r);
+    lo.y = std::min(lo.y, p.y - r);
+    hi.x = std::max(hi.x, p.x + r);
+    hi.y = std::max(hi.y, p.y + r);
+  };
+  for (const BodyDef& b : scene.bodies) extend(b.position, b.radius);
+  for (const WallDef& w : scene.walls) { extend(w.from, 0.0); extend(w.to, 0.0); }
+  for (const BoxDef& b : scene.boxes) { extend(b.min, 0.0); extend(b.max, 0.0); }
+  for (const SurfaceDef& sf : scene.surfaces) for (Vec2 p : sf.points) extend(p, 0.0);
+  s.length = hi.x >= lo.x ? std::max(length(hi - lo), 1e-9) : 1.0;
+
+  double mass = 0.0, ke = 0.0, p = 0.0, l = 0.0;
+  for (const BodyDef& b : scene.bodies) {
+    if (b.is_static) continue;
+    mass += b.mass;
+    ke += 0.5 * b.mass * length_squared(b.velocity);
+    p += b.mass * length(b.velocity);
+    l += b.mass * length(b.position) * length(b.velocity);
+  }
+  double u = 0.0;
+  if (scene.world.newtonian) {
+    for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+      for (std::size_t j = i + 1; j < scene.bodies.size(); ++j) {
+        u += std::abs(newtonian_potential(scene.world.G, scene.world.softening, scene.bodies[i].mass,
+                                          scene.bodies[j].mass, scene.bodies[i].position, scene.bodies[j].position));
+      }
+    }
+  }
+  s.energy = ke + mass * length(scene.world.gravity) * s.length + u;
+  if (!(s.energy > 0.0)) s.energy = 1.0;   // nothing moves and nothing pulls: 1 J
+  s.momentum = std::max(p, std::sqrt(2.0 * mass * s.energy));
+  if (!(s.momentum > 0.0)) s.momentum = 1.0;
+  s.angular_momentum = l + s.momentum * s.length;
+  return s;
+}
+
+}  // namespace physval

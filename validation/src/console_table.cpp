@@ -1,0 +1,93 @@
+#include "physval/validation/console_table.hpp"
+
+#include <cstdio>
+#include <string>
+
+namespace physval {
+
+namespace {
+
+std::string num(const std::optional<double>& v, const char* format = "%.1e") {
+  if (!v) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, format, *v);
+  return buf;
+}
+
+std::string metric(const RunRecord& r, const char* name, const char* format = "%.1e") {
+  auto it = r.metrics.find(name);
+  return it == r.metrics.end() ? "-" : num(it->second, format);
+}
+
+std::string pad(std::string s, std::size_t w) {
+  if (s.size() > w) s = s.substr(0, w);
+  return s + std::string(w - s.size(), ' ');
+}
+std::string rpad(const std::string& s, std::size_t w) {
+  return s.size() >= w ? s : std::string(w - s.size(), ' ') + s;
+}
+
+}  // namespace
+
+void print_suite_table(std::ostream& os, const SuiteResult& result) {
+  int ok = 0, diverged = 0, unsupported = 0, error = 0, checks_pass = 0, checks_fail = 0;
+  for (const ScenarioResult& sr : result.scenarios) {
+    const Reference& ref = sr.reference;
+    os << '\n' << sr.scene.name << "  (dt " << num(sr.scene.dt, "%.4g") << " s, " << sr.scene.steps() << " steps; reference: ";
+    if (!ref.available) os << "none, " << ref.reason;
+    else if (ref.converged) os << "core dt " << num(ref.dt, "%.3g") << ", converged to " << num(ref.convergence_error) << " m";
+    else os << ref.reason;
+    os << ")\n";
+    os << "  " << pad("engine", 7) << pad("status", 12) << rpad("E drift", 8) << rpad("P drift", 8) << rpad("pos div", 9)
+       << rpad("E div", 8) << rpad("contact err", 12) << rpad("steps", 6) << rpad("miss", 5) << rpad("extra", 6)
+       << rpad("wall ms", 9) << rpad("checks", 7) << '\n';
+    for (const RunRecord& r : sr.runs) {
+      int pass = 0, total = 0;
+      for (const Check& c : r.checks) {
+        if (!c.enforced) continue;
+        ++total;
+        pass += c.pass ? 1 : 0;
+      }
+      checks_pass += pass;
+      checks_fail += total - pass;
+      switch (r.status) {
+        case RunStatus::Ok: ++ok; break;
+        case RunStatus::Diverged: ++diverged; break;
+        case RunStatus::Unsupported: ++unsupported; break;
+        case RunStatus::Error: ++error; break;
+      }
+      std::string contact = metric(r, "contact_time_error");
+      if (contact != "-") contact += " s";
+      os << "  " << pad(r.engine, 7) << pad(run_status_name(r.status), 12) << rpad(metric(r, "energy_drift"), 8)
+         << rpad(metric(r, "linear_momentum_drift"), 8) << rpad(metric(r, "position_divergence"), 9)
+         << rpad(metric(r, "energy_divergence"), 8) << rpad(contact, 12)
+         << rpad(metric(r, "contact_time_error_steps", "%.2f"), 6) << rpad(metric(r, "missed_contacts", "%.0f"), 5)
+         << rpad(metric(r, "extra_contacts", "%.0f"), 6)
+         << rpad(r.status == RunStatus::Unsupported || r.status == RunStatus::Error ? "-" : num(r.wall_seconds * 1e3, "%.2f"), 9)
+         << rpad(total == 0 ? "-" : std::to_string(pass) + "/" + std::to_string(total), 7) << '\n';
+    }
+    for (const RunRecord& r : sr.runs) {
+      if (r.status != RunStatus::Ok) os << "    " << r.engine << ": " << r.reason << '\n';
+      for (const std::string& l : r.limits_hit) os << "    " << r.engine << " limit: " << l << '\n';
+      for (const Check& c : r.checks) {
+        if (c.pass) continue;
+        os << "    " << r.engine << (c.enforced ? " FAILED " : " missed ") << c.what << ": " << num(c.value, "%.3g")
+           << " > " << num(c.limit, "%.3g") << (c.enforced ? "" : " (reported)") << '\n';
+      }
+    }
+    for (const PairComparison& p : sr.pairs) {
+      auto m = [&](const char* k) {
+        auto it = p.metrics.find(k);
+        return it == p.metrics.end() ? std::string("-") : num(it->second);
+      };
+      os << "    " << p.a << " vs " << p.b << ": pos " << m("position_divergence") << " m, E " << m("energy_divergence")
+         << ", contacts " << m("contact_time_error") << " s\n";
+    }
+  }
+  const int runs = ok + diverged + unsupported + error;
+  os << '\n'
+     << runs << " runs: " << ok << " ok, " << diverged << " diverged, " << unsupported << " unsupported, " << error
+     << " error; checks: " << checks_pass << " passed, " << checks_fail << " failed\n";
+}
+
+}  // namespace physval

@@ -1,0 +1,115 @@
+#include "physval/validation/gate.hpp"
+
+#include <cmath>
+#include <map>
+#include <sstream>
+
+namespace physval {
+
+namespace {
+
+std::string xml_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t') out += ' ';
+        else out += c;
+    }
+  }
+  return out;
+}
+
+std::string g(double v) {
+  std::ostringstream os;
+  os.precision(4);
+  os << v;
+  return os.str();
+}
+
+// Metrics where bigger is worse and a baseline comparison makes sense.
+constexpr const char* kErrorMetrics[] = {
+    "energy_drift", "linear_momentum_drift", "angular_momentum_drift", "energy_divergence",
+    "linear_momentum_divergence", "position_divergence", "contact_time_error"};
+
+}  // namespace
+
+std::string junit_xml(const SuiteResult& result) {
+  int tests = 0, failures = 0, skipped = 0;
+  double total_time = 0.0;
+  std::ostringstream cases;
+  for (const ScenarioResult& sr : result.scenarios) {
+    for (const RunRecord& r : sr.runs) {
+      ++tests;
+      total_time += r.wall_seconds;
+      cases << "    <testcase classname=\"physval." << xml_escape(sr.scene.name) << "\" name=\"" << xml_escape(r.engine)
+            << "\" time=\"" << r.wall_seconds << "\">\n";
+      if (r.status == RunStatus::Unsupported) {
+        ++skipped;
+        cases << "      <skipped message=\"" << xml_escape(r.reason) << "\"/>\n";
+      } else if (!r.passed()) {
+        ++failures;
+        std::ostringstream detail;
+        if (r.status != RunStatus::Ok) detail << run_status_name(r.status) << ": " << r.reason << '\n';
+        for (const Check& c : r.checks) {
+          if (c.pass || !c.enforced) continue;
+          detail << c.what << " = " << (c.value ? g(*c.value) : std::string("not measured")) << " > limit " << g(c.limit)
+                 << '\n';
+        }
+        std::string first = detail.str().substr(0, detail.str().find('\n'));
+        cases << "      <failure message=\"" << xml_escape(first) << "\" type=\"physval\">" << xml_escape(detail.str())
+              << "</failure>\n";
+      }
+      cases << "    </testcase>\n";
+    }
+  }
+  std::ostringstream os;
+  os << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+     << "<testsuites name=\"physval\" tests=\"" << tests << "\" failures=\"" << failures << "\" skipped=\"" << skipped
+     << "\" time=\"" << total_time << "\">\n"
+     << "  <testsuite name=\"physval\" tests=\"" << tests << "\" failures=\"" << failures << "\" errors=\"0\" skipped=\""
+     << skipped << "\" time=\"" << total_time << "\">\n"
+     << cases.str() << "  </testsuite>\n</testsuites>\n";
+  return os.str();
+}
+
+int apply_baseline(SuiteResult& result, const nlohmann::json& baseline, double factor, double floor) {
+  std::map<std::pair<std::string, std::string>, const nlohmann::json*> old;
+  if (baseline.contains("runs") && baseline["runs"].is_array()) {
+    for (const nlohmann::json& r : baseline["runs"]) {
+      if (r.contains("scenario") && r.contains("engine")) {
+        old[{r["scenario"].get<std::string>(), r["engine"].get<std::string>()}] = &r;
+      }
+    }
+  }
+  int matched = 0;
+  for (ScenarioResult& sr : result.scenarios) {
+    for (RunRecord& r : sr.runs) {
+      auto it = old.find({r.scenario, r.engine});
+      if (it == old.end() || !it->second->contains("metrics")) continue;
+      ++matched;
+      const nlohmann::json& om = (*it->second)["metrics"];
+      for (const char* name : kErrorMetrics) {
+        if (!om.contains(name) || !om[name].is_number()) continue;
+        auto mine = r.metrics.find(name);
+        if (mine == r.metrics.end() || !mine->second) continue;
+        const double before = om[name].get<double>();
+        Check c;
+        c.what = std::string("baseline.") + name;
+        c.limit = factor * before + floor;
+        c.value = *mine->second;
+        c.pass = std::isfinite(*c.value) && *c.value <= c.limit;
+        c.enforced = true;
+        r.checks.push_back(c);
+      }
+    }
+  }
+  return matched;
+}
+
+}  // namespace physval

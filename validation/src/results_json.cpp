@@ -1,0 +1,183 @@
+#include "physval/validation/results_json.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+#include "physval/adapters/registry.hpp"
+
+namespace physval {
+
+using nlohmann::json;
+
+namespace {
+
+json opt(const std::optional<double>& v) {
+  if (!v || !std::isfinite(*v)) return nullptr;
+  return *v;
+}
+json vec(Vec2 v) { return json::array({v.x, v.y}); }
+
+std::string iso_now() {
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  std::ostringstream os;
+  os << std::put_time(&tm, "%Y-%m-%dT%H:%M:%SZ");
+  return os.str();
+}
+
+std::string safe_file_name(const std::string& s) {
+  std::string out;
+  for (char c : s) out += (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-') ? c : '_';
+  return out;
+}
+
+}  // namespace
+
+json context_json() {
+  char host[256] = {};
+  ::gethostname(host, sizeof host - 1);
+  json engines = json::array();
+  for (const EngineFactory& f : engine_registry()) {
+    engines.push_back({{"name", f.info.name}, {"version", f.info.version}, {"precision", precision_name(f.info.precision)}});
+  }
+  return {{"physval_version", PHYSVAL_VERSION},
+          {"schema_version", 1},
+          {"date", iso_now()},
+          {"host", host},
+          {"build_type", PHYSVAL_BUILD_TYPE},
+          {"compiler", std::string("g++ ") + __VERSION__},
+          {"engines", engines}};
+}
+
+json run_to_json(const RunRecord& r) {
+  json metrics = json::object();
+  for (const auto& [k, v] : r.metrics) metrics[k] = opt(v);
+  json contacts = json::array();
+  for (const ContactRecord& c : r.contacts) contacts.push_back({{"a", c.a}, {"b", c.b}, {"time", c.time}, {"step", c.step}});
+  json final_states = json::array();
+  for (std::size_t i = 0; i < r.final_states.size() && i < r.bodies.size(); ++i) {
+    const BodyState& s = r.final_states[i];
+    final_states.push_back({{"body", r.bodies[i].name},
+                            {"position", vec(s.position)},
+                            {"velocity", vec(s.velocity)},
+                            {"alive", s.alive}});
+  }
+  json checks = json::array();
+  for (const Check& c : r.checks) {
+    checks.push_back({{"what", c.what}, {"limit", c.limit}, {"value", opt(c.value)}, {"pass", c.pass}, {"enforced", c.enforced}});
+  }
+  json settings = json::object();
+  for (const auto& [k, v] : r.settings) settings[k] = v;
+  return {{"scenario", r.scenario},
+          {"engine", r.engine},
+          {"engine_version", r.engine_version},
+          {"precision", r.precision},
+          {"dt", r.dt},
+          {"steps", r.steps},
+          {"status", run_status_name(r.status)},
+          {"reason", r.reason},
+          {"diverged_at", opt(r.diverged_at)},
+          {"wall_seconds", r.wall_seconds},
+          {"load_seconds", r.load_seconds},
+          {"settings", settings},
+          {"limits_hit", r.limits_hit},
+          {"metrics", metrics},
+          {"contacts", contacts},
+          {"final", final_states},
+          {"checks", checks}};
+}
+
+json suite_to_json(const SuiteResult& result) {
+  json runs = json::array(), references = json::array(), comparisons = json::array();
+  for (const ScenarioResult& sr : result.scenarios) {
+    for (const RunRecord& r : sr.runs) runs.push_back(run_to_json(r));
+    json ref = {{"scenario", sr.scene.name},
+                {"available", sr.reference.available},
+                {"converged", sr.reference.converged},
+                {"reason", sr.reference.reason},
+                {"dt", sr.reference.dt},
+                {"convergence_error", sr.reference.convergence_error}};
+    json contacts = json::array();
+    if (sr.reference.run) {
+      for (const ContactRecord& c : sr.reference.run->contacts) contacts.push_back({{"a", c.a}, {"b", c.b}, {"time", c.time}});
+    }
+    ref["contacts"] = contacts;
+    references.push_back(ref);
+    for (const PairComparison& p : sr.pairs) {
+      json m = json::object();
+      for (const auto& [k, v] : p.metrics) m[k] = opt(v);
+      comparisons.push_back({{"scenario", p.scenario}, {"a", p.a}, {"b", p.b}, {"metrics", m}});
+    }
+  }
+  return {{"physval_version", PHYSVAL_VERSION},
+          {"context", context_json()},
+          {"gates_enforced", result.gates_enforced},
+          {"runs", runs},
+          {"references", references},
+          {"comparisons", comparisons}};
+}
+
+void write_file_atomically(const std::filesystem::path& path, const std::string& text) {
+  const std::filesystem::path dir = path.parent_path().empty() ? std::filesystem::path(".") : path.parent_path();
+  std::filesystem::create_directories(dir);
+  std::string tmp_name = ".";
+  tmp_name.append(path.filename().string()).append(".tmp.").append(std::to_string(::getpid()));
+  const std::filesystem::path tmp = dir / tmp_name;
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+    out << text;
+    out.flush();
+    if (!out) {
+      std::filesystem::remove(tmp);
+      throw std::runtime_error("cannot write " + tmp.string());
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp);
+    throw std::runtime_error("cannot rename " + tmp.string() + " to " + path.string() + ": " + ec.message());
+  }
+}
+
+void write_results(const std::filesystem::path& dir, const SuiteResult& result) {
+  // Series first: results.json, written last, is what marks a complete output.
+  constexpr std::size_t kMaxBodiesInSeries = 32;
+  for (const ScenarioResult& sr : result.scenarios) {
+    auto write_series = [&](const RunRecord& r, const std::string& label) {
+      if (r.series.time.empty()) return;
+      std::ostringstream os;
+      os.precision(12);
+      const std::size_t nb = std::min(r.bodies.size(), kMaxBodiesInSeries);
+      os << "t,energy,kinetic,potential,px,py,angular_momentum";
+      for (std::size_t i = 0; i < nb; ++i) os << ",x_" << r.bodies[i].name << ",y_" << r.bodies[i].name;
+      os << '\n';
+      for (std::size_t k = 0; k < r.series.time.size(); ++k) {
+        const Totals& t = r.series.totals[k];
+        os << r.series.time[k] << ',' << t.energy() << ',' << t.kinetic << ',' << t.potential << ',' << t.momentum.x
+           << ',' << t.momentum.y << ',' << t.angular_momentum;
+        const auto& st = r.series.states[k];
+        for (std::size_t i = 0; i < nb; ++i) {
+          if (i < st.size() && st[i].alive) os << ',' << st[i].position.x << ',' << st[i].position.y;
+          else os << ",nan,nan";
+        }
+        os << '\n';
+      }
+      write_file_atomically(dir / "series" / safe_file_name(sr.scene.name) / (safe_file_name(label) + ".csv"), os.str());
+    };
+    for (const RunRecord& r : sr.runs) write_series(r, r.engine);
+    if (sr.reference.run) write_series(*sr.reference.run, "reference");
+  }
+  write_file_atomically(dir / "results.json", suite_to_json(result).dump(2) + "\n");
+}
+
+}  // namespace physval

@@ -1,0 +1,341 @@
+// Runs one engine on one scene: load, step, sample, collect contacts. The isolated
+// variant forks, so an engine that crashes, aborts or hangs costs only its own run.
+#include "physval/validation/runner.hpp"
+
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <numbers>
+
+#include "physval/adapters/registry.hpp"
+#include "physval/validation/conservation.hpp"
+#include "physval/validation/run_record_io.hpp"
+
+namespace physval {
+
+const char* run_status_name(RunStatus s) {
+  switch (s) {
+    case RunStatus::Ok: return "ok";
+    case RunStatus::Diverged: return "diverged";
+    case RunStatus::Unsupported: return "unsupported";
+    case RunStatus::Error: return "error";
+  }
+  return "error";
+}
+
+bool RunRecord::passed() const {
+  if (status == RunStatus::Unsupported) return true;
+  if (status != RunStatus::Ok) return false;
+  return std::all_of(checks.begin(), checks.end(), [](const Check& c) { return c.pass || !c.enforced; });
+}
+
+Scene effective_scene(const Scene& scene, const RunOptions& options) {
+  Scene s = scene;
+  if (options.dt) s.dt = *options.dt;
+  if (options.duration) s.duration = *options.duration;
+  return s;
+}
+
+long sample_every(const Scene& scene, std::size_t max_sample_states) {
+  const long steps = scene.steps();
+  long every;
+  if (scene.sample_interval > 0.0) {
+    every = std::max(1L, std::lround(scene.sample_interval / scene.dt));
+  } else {
+    every = std::max(1L, steps / 400);   // about 400 samples
+  }
+  const std::size_t bodies = std::max<std::size_t>(1, scene.bodies.size());
+  const std::size_t max_samples = std::max<std::size_t>(2, max_sample_states / bodies);
+  while (static_cast<std::size_t>(steps / every) + 1 > max_samples) every *= 2;
+  return every;
+}
+
+std::vector<const EngineFactory*> engines_for(const Scene& scene, const std::vector<std::string>& wanted) {
+  std::vector<const EngineFactory*> out;
+  for (const EngineFactory& f : engine_registry()) {
+    if (!wanted.empty() && std::find(wanted.begin(), wanted.end(), f.info.name) == wanted.end()) continue;
+    if (!scene.engines.empty() &&
+        std::find(scene.engines.begin(), scene.engines.end(), f.info.name) == scene.engines.end()) {
+      continue;
+    }
+    out.push_back(&f);
+  }
+  return out;
+}
+
+namespace {
+
+RunRecord blank_record(const Scene& scene, const EngineInfo& info) {
+  RunRecord r;
+  r.scenario = scene.name;
+  r.engine = info.name;
+  r.engine_version = info.version;
+  r.precision = precision_name(info.precision);
+  r.dt = scene.dt;
+  r.steps_planned = scene.steps();
+  return r;
+}
+
+std::string object_name(const Scene& scene, const std::vector<BodyMeta>& metas, ObjectRef ref) {
+  switch (ref.kind) {
+    case ObjectRef::Kind::Body:
+      return ref.index < metas.size() ? metas[ref.index].name : "body#" + std::to_string(ref.index);
+    case ObjectRef::Kind::Wall:
+      return ref.index < scene.walls.size() ? scene.walls[ref.index].name : "wall#" + std::to_string(ref.index);
+    case ObjectRef::Kind::Box:
+      return ref.index < scene.boxes.size() ? scene.boxes[ref.index].name : "box#" + std::to_string(ref.index);
+    case ObjectRef::Kind::Surface:
+      return ref.index < scene.surfaces.size() ? scene.surfaces[ref.index].name : "surface#" + std::to_string(ref.index);
+  }
+  return "?";
+}
+
+void refresh_metas(const Engine& engine, std::vector<BodyMeta>& metas) {
+  const std::size_t n = engine.body_count();
+  for (std::size_t i = metas.size(); i < n; ++i) metas.push_back(engine.body_meta(i));
+}
+
+bool states_finite(const std::vector<BodyState>& states) {
+  for (const BodyState& s : states) {
+    if (!s.alive) continue;
+    if (!is_finite(s.position) || !is_finite(s.velocity) || !std::isfinite(s.angle)) return false;
+  }
+  return true;
+}
+
+struct ProbeTracker {
+  std::size_t body;
+  Vec2 around;
+  bool tracks_period;
+  double last_angle = 0.0;
+  double accumulated = 0.0;
+};
+
+}  // namespace
+
+RunRecord unsupported_run(const Scene& scene, const EngineInfo& info, const std::vector<std::string>& missing) {
+  RunRecord r = blank_record(scene, info);
+  r.status = RunStatus::Unsupported;
+  r.reason = "cannot model: ";
+  for (std::size_t i = 0; i < missing.size(); ++i) r.reason += (i ? ", " : "") + missing[i];
+  return r;
+}
+
+RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const RunOptions& options) {
+  RunRecord r = blank_record(scene, factory.info);
+  using clock = std::chrono::steady_clock;
+  std::unique_ptr<Engine> engine;
+  std::vector<BodyState> states;
+  try {
+    engine = factory.create();
+    const auto t_load = clock::now();
+    engine->load(scene);
+    r.load_seconds = std::chrono::duration<double>(clock::now() - t_load).count();
+    r.settings = engine->settings();
+    refresh_metas(*engine, r.bodies);
+
+    // Probes: every step, for the bodies the expectations name.
+    std::vector<ProbeTracker> trackers;
+    auto add_probe = [&](const std::string& body, bool period, Vec2 around) {
+      const int i = scene.body_index(body);
+      if (i < 0) return;
+      for (std::size_t k = 0; k < r.probes.size(); ++k) {
+        if (r.probes[k].body == body) {
+          if (period) { trackers[k].tracks_period = true; trackers[k].around = around; }
+          return;
+        }
+      }
+      r.probes.push_back(Probe{body});
+      trackers.push_back({static_cast<std::size_t>(i), around, period});
+    };
+    for (const ExpectedApex& a : scene.expect.apex) add_probe(a.body, false, {});
+    for (const ExpectedPeriod& p : scene.expect.period) add_probe(p.body, true, p.around);
+
+    const long every = sample_every(scene, options.max_sample_states);
+    auto sample = [&](double t) {
+      engine->read_states(states);
+      refresh_metas(*engine, r.bodies);
+      r.series.time.push_back(t);
+      r.series.totals.push_back(compute_totals(scene, r.bodies, states));
+      r.series.states.push_back(states);
+      return states_finite(states);
+    };
+    auto update_probes = [&](double t, bool have_states) {
+      if (trackers.empty()) return;
+      if (!have_states) engine->read_states(states);
+      for (std::size_t k = 0; k < trackers.size(); ++k) {
+        const BodyState& s = states[trackers[k].body];
+        Probe& p = r.probes[k];
+        if (s.position.y > p.max_y) {
+          p.max_y = s.position.y;
+          p.max_y_time = t;
+        }
+        if (trackers[k].tracks_period) {
+          const Vec2 d = s.position - trackers[k].around;
+          const double angle = std::atan2(d.y, d.x);
+          double delta = angle - trackers[k].last_angle;
+          if (delta > std::numbers::pi) delta -= 2.0 * std::numbers::pi;
+          if (delta < -std::numbers::pi) delta += 2.0 * std::numbers::pi;
+          if (t > 0.0) trackers[k].accumulated += delta;
+          trackers[k].last_angle = angle;
+          const int full = static_cast<int>(std::floor(std::abs(trackers[k].accumulated) / (2.0 * std::numbers::pi)));
+          if (full > p.full_revolutions) {
+            // Interpolate within the step to the moment the angle completed the turn.
+            const double target = 2.0 * std::numbers::pi * full;
+            const double over = std::abs(trackers[k].accumulated) - target;
+            const double frac = std::abs(delta) > 0.0 ? over / std::abs(delta) : 0.0;
+            p.last_full_rev_time = t - frac * scene.dt;
+            p.full_revolutions = full;
+          }
+          p.revolutions = std::abs(trackers[k].accumulated) / (2.0 * std::numbers::pi);
+        }
+      }
+    };
+
+    const long n = scene.steps();
+    if (!sample(0.0)) {
+      r.status = RunStatus::Diverged;
+      r.reason = "the initial state is not finite";
+      r.diverged_at = 0.0;
+    }
+    update_probes(0.0, true);
+    double wall = 0.0;
+    for (long k = 1; k <= n && r.status == RunStatus::Ok; ++k) {
+      const auto t0 = clock::now();
+      engine->step(scene.dt);
+      wall += std::chrono::duration<double>(clock::now() - t0).count();
+      r.steps = k;
+      const std::vector<ContactEvent>& events = engine->contacts();
+      if (!events.empty()) {
+        refresh_metas(*engine, r.bodies);
+        for (const ContactEvent& e : events) {
+          r.contacts.push_back({object_name(scene, r.bodies, e.a), object_name(scene, r.bodies, e.b), e.time, k});
+        }
+      }
+      const double t = engine->time();
+      const bool sampled = (k % every == 0) || k == n;
+      if (sampled && !sample(t)) {
+        r.status = RunStatus::Diverged;
+        r.reason = "state became NaN or infinite";
+        r.diverged_at = t;
+      }
+      update_probes(t, sampled);
+    }
+    r.wall_seconds = wall;
+    r.limits_hit = engine->limits_hit();
+    engine->read_states(states);
+    r.final_states = states;
+    refresh_metas(*engine, r.bodies);
+  } catch (const std::exception& e) {
+    r.status = RunStatus::Error;
+    r.reason = std::string("engine failed: ") + e.what();
+  } catch (...) {
+    r.status = RunStatus::Error;
+    r.reason = "engine failed with an unknown exception";
+  }
+  return r;
+}
+
+namespace {
+
+bool write_all(int fd, const std::uint8_t* data, std::size_t size) {
+  while (size > 0) {
+    const ssize_t w = ::write(fd, data, size);
+    if (w < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    data += w;
+    size -= static_cast<std::size_t>(w);
+  }
+  return true;
+}
+
+}  // namespace
+
+RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, const RunOptions& options) {
+  if (!options.isolate) return run_engine(scene, factory, options);
+  int fds[2];
+  if (::pipe(fds) != 0) return run_engine(scene, factory, options);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(fds[0]);
+    ::close(fds[1]);
+    return run_engine(scene, factory, options);
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    int code = 0;
+    try {
+      const RunRecord r = run_engine(scene, factory, options);
+      const std::vector<std::uint8_t> bytes = encode_run_record(r);
+      if (!write_all(fds[1], bytes.data(), bytes.size())) code = 3;
+    } catch (...) {
+      code = 4;
+    }
+    ::close(fds[1]);
+    ::_exit(code);   // no atexit handlers, no double-flushed stdio buffers
+  }
+  ::close(fds[1]);
+  std::vector<std::uint8_t> bytes;
+  std::uint8_t buffer[1 << 16];
+  const auto start = std::chrono::steady_clock::now();
+  bool timed_out = false;
+  for (;;) {
+    int wait_ms = -1;
+    if (options.timeout_seconds > 0.0) {
+      const double left = options.timeout_seconds -
+                          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (left <= 0.0) {
+        timed_out = true;
+        break;
+      }
+      wait_ms = static_cast<int>(std::ceil(left * 1000.0));
+    }
+    pollfd p{fds[0], POLLIN, 0};
+    const int ready = ::poll(&p, 1, wait_ms);
+    if (ready < 0 && errno == EINTR) continue;
+    if (ready == 0) continue;   // loop re-checks the deadline
+    const ssize_t got = ::read(fds[0], buffer, sizeof buffer);
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) break;
+    bytes.insert(bytes.end(), buffer, buffer + got);
+  }
+  ::close(fds[0]);
+  if (timed_out) ::kill(pid, SIGKILL);
+  int wstatus = 0;
+  while (::waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
+  }
+  RunRecord fallback = blank_record(scene, factory.info);
+  fallback.status = RunStatus::Error;
+  if (timed_out) {
+    fallback.reason = "timed out after " + std::to_string(options.timeout_seconds) + " s";
+    return fallback;
+  }
+  if (WIFSIGNALED(wstatus)) {
+    const int sig = WTERMSIG(wstatus);
+    fallback.reason = std::string("engine crashed: signal ") + std::to_string(sig) + " (" + strsignal(sig) + ")";
+    return fallback;
+  }
+  if (!WIFEXITED(wstatus) || WEXITSTATUS(wstatus) != 0 || bytes.empty()) {
+    fallback.reason = "engine process exited with status " + std::to_string(WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1);
+    return fallback;
+  }
+  try {
+    return decode_run_record(bytes);
+  } catch (const std::exception& e) {
+    fallback.reason = std::string("could not read the engine process's result: ") + e.what();
+    return fallback;
+  }
+}
+
+}  // namespace physval
