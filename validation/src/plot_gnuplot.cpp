@@ -65,16 +65,28 @@ std::string number(double v) {
 
 bool keep(double v, bool log_axis) { return std::isfinite(v) && (!log_axis || v > 0.0); }
 
-// The points of a series a panel can draw.
+// The points of a series a panel can draw, in order. A value the panel cannot show
+// (not finite, or not positive on a log axis) breaks the line there: it becomes a gap,
+// marked by a NaN pair. Gaps are never doubled and never lead or trail (two blank lines
+// in a data file would end gnuplot's data block).
 std::vector<std::pair<double, double>> drawable(const Series& s, const Panel& p) {
   std::vector<std::pair<double, double>> out;
   const std::size_t n = std::min(s.x.size(), s.y.size());
   out.reserve(n);
+  bool gap = false;
   for (std::size_t i = 0; i < n; ++i) {
-    if (keep(s.x[i], p.x.log) && keep(s.y[i], p.y.log)) out.emplace_back(s.x[i], s.y[i]);
+    if (keep(s.x[i], p.x.log) && keep(s.y[i], p.y.log)) {
+      if (gap && !out.empty()) out.emplace_back(NAN, NAN);
+      gap = false;
+      out.emplace_back(s.x[i], s.y[i]);
+    } else {
+      gap = true;
+    }
   }
   return out;
 }
+
+bool is_gap(const std::pair<double, double>& pt) { return std::isnan(pt.first); }
 
 struct Extent {
   double lo = INFINITY;
@@ -107,9 +119,11 @@ std::string axis_commands(char name, const Axis& axis, const Extent& data) {
       if (i > 0) os << ", ";
       os << quoted(axis.tics[i].second) << ' ' << number(axis.tics[i].first);
     }
-    os << ") noenhanced\n";
+    os << ")";
+    if (axis.tic_rotation != 0) os << " rotate by " << axis.tic_rotation << (name == 'x' ? " right" : "");
+    os << " noenhanced\n";
   } else {
-    os << "set " << a << "tics auto enhanced\n";
+    os << "set " << a << "tics auto norotate enhanced\n";
   }
   os << "set " << a << "range [" << (axis.min ? number(*axis.min) : std::string("*")) << ':'
      << (axis.max ? number(*axis.max) : std::string("*")) << "]\n";
@@ -165,7 +179,9 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
     std::vector<std::vector<std::pair<double, double>>> data;
     for (const Series& s : panel.series) {
       data.push_back(drawable(s, panel));
-      for (const auto& [x, y] : data.back()) {
+      for (const auto& pt : data.back()) {
+        if (is_gap(pt)) continue;
+        const auto [x, y] = pt;
         ex.lo = std::min(ex.lo, x);
         ex.hi = std::max(ex.hi, x);
         ey.lo = std::min(ey.lo, y);
@@ -186,6 +202,12 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
       os << "set key " << panel.key << " box opaque samplen 3 spacing 1.15 font ',10' noenhanced\n";
     }
     os << (panel.equal_aspect ? "set size ratio -1\n" : "set size noratio\n");
+    for (std::size_t i = 0; i < panel.labels.size(); ++i) {
+      const Label& l = panel.labels[i];
+      if (!std::isfinite(l.x) || !std::isfinite(l.y)) continue;
+      os << "set label " << (i + 2) << ' ' << quoted(l.text) << " at " << number(l.x) << ',' << number(l.y)
+         << " offset 0.6,0.6 font ',10' front noenhanced\n";
+    }
 
     std::vector<std::string> parts;
     for (std::size_t i = 0; i < panel.series.size(); ++i) {
@@ -199,6 +221,7 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
         << (s.rgb.empty() ? palette()[static_cast<std::size_t>(colour) % palette().size()] : s.rgb) << "'"
         << " lw " << number(s.line_width) << " dt " << s.dash;
       if (s.style != Style::Lines) p << " pt " << pt << " ps " << number(s.point_size);
+      if (s.style == Style::LinesPoints && s.point_interval > 1) p << " pi " << s.point_interval;
       if (s.title.empty()) {
         p << " notitle";
       } else {
@@ -256,9 +279,13 @@ void render_png(const Figure& figure, const fs::path& png) {
       for (const Series& s : panel.series) {
         const auto points = drawable(s, panel);
         if (points.empty()) continue;
-        for (const auto& [x, y] : points) {
+        for (const auto& pt : points) {
+          if (is_gap(pt)) {
+            data << "\n";   // one blank line: a break in the line, same block
+            continue;
+          }
           char line[80];
-          std::snprintf(line, sizeof line, "%.17g %.17g\n", x, y);
+          std::snprintf(line, sizeof line, "%.17g %.17g\n", pt.first, pt.second);
           data << line;
         }
         data << "\n\n";   // two blank lines end a gnuplot `index` block

@@ -32,6 +32,7 @@ struct Series {
   int dash = 1;                    // gnuplot dash type: 1 solid, 2 dashed, 3 dotted, ...
   int point_type = -1;             // gnuplot point type; -1: one per series in turn
   double point_size = 1.0;
+  int point_interval = 1;          // LinesPoints: a marker every n-th point
   double line_width = 2.0;
 };
 
@@ -42,6 +43,14 @@ struct Axis {
   std::optional<double> max;
   // Fixed tic marks with labels (a categorical axis, e.g. one row per engine).
   std::vector<std::pair<double, std::string>> tics;
+  int tic_rotation = 0;            // degrees, for long tic labels
+};
+
+// Text placed at data coordinates (a body's name at its start).
+struct Label {
+  double x = 0.0;
+  double y = 0.0;
+  std::string text;
 };
 
 struct Panel {
@@ -52,6 +61,7 @@ struct Panel {
   std::string key = "top right";   // gnuplot key placement: "outside right top", "off", ...
   bool equal_aspect = false;       // one metre is as long on x as on y (trajectories)
   std::string note;                // small text under the title ("" for none)
+  std::vector<Label> labels;
 };
 
 struct Figure {
