@@ -14,6 +14,7 @@
 #include <toml++/toml.h>
 
 #include "physval/adapters/registry.hpp"
+#include "physval/core/forces.hpp"
 #include "physval/validation/metric_names.hpp"
 
 namespace physval {
@@ -371,7 +372,41 @@ void read_body(Context& ctx, const toml::table& t, std::size_t i, BodyDef& b) {
   }
   r.read("static", b.is_static);
   r.read("mass", b.mass, "> 0", [](double v) { return v > 0.0; });
-  r.read("position", b.position, true);
+  if (r.has("vertices") || r.has("vertex_masses")) {
+    // A polygon with a mass at each vertex: the body is its centre of mass (lecture 4).
+    std::vector<Vec2> vertices;
+    std::vector<double> masses;
+    if (const toml::node* vn = r.node("vertices")) {
+      if (const auto* a = vn->as_array()) {
+        for (std::size_t k = 0; k < a->size(); ++k) {
+          if (auto v = r.vec2(*a->get(k), indexed(r.key_path("vertices"), k))) vertices.push_back(*v);
+        }
+      } else {
+        r.error_at(*vn, "vertices", std::string("expected an array of [x, y], got ") + type_name(*vn));
+      }
+    } else {
+      r.missing("vertices");
+    }
+    if (const toml::node* mn = r.node("vertex_masses")) {
+      if (auto m = r.numbers(*mn, r.key_path("vertex_masses"))) masses = *m;
+      if (masses.size() != vertices.size()) {
+        r.error_at(*mn, "vertex_masses", "needs one mass per vertex (" + std::to_string(vertices.size()) + ")");
+      } else if (std::any_of(masses.begin(), masses.end(), [](double m) { return !(m > 0.0); })) {
+        r.error_at(*mn, "vertex_masses", "every vertex mass must be > 0");
+      } else if (!vertices.empty()) {
+        b.position = centre_of_mass(vertices, masses);
+        b.mass = 0.0;
+        for (double m : masses) b.mass += m;
+      }
+    } else {
+      r.missing("vertex_masses");
+    }
+    if (r.has("position")) r.error_here("position", "give either position or vertices, not both");
+    if (r.has("mass")) r.error_here("mass", "give either mass or vertex_masses, not both");
+    r.mark_used("position");
+  } else {
+    r.read("position", b.position, true);
+  }
   r.read("velocity", b.velocity);
   r.read("angle", b.angle);
   r.read("angular_velocity", b.angular_velocity);
@@ -527,9 +562,14 @@ void read_engine_options(Context& ctx, const toml::table& t, const EngineInfo& i
 
 // Checks that need the whole scene: unique names, references by name.
 void check_references(Context& ctx, const toml::table& root, Scene& s) {
-  auto where = [&](std::string_view array, std::size_t i) -> toml::source_region {
+  auto where = [&](std::string_view array, std::size_t i, std::string_view key = {}) -> toml::source_region {
     if (const auto* a = root.get_as<toml::array>(array)) {
-      if (i < a->size()) return a->get(i)->source();
+      if (i < a->size()) {
+        if (const auto* t = a->get(i)->as_table(); t != nullptr && !key.empty()) {
+          if (const toml::node* n = t->get(key)) return n->source();
+        }
+        return a->get(i)->source();
+      }
     }
     if (const auto* t = root.get_as<toml::table>(array)) return t->source();
     return root.source();
@@ -538,7 +578,7 @@ void check_references(Context& ctx, const toml::table& root, Scene& s) {
   auto claim = [&](const std::string& name, const std::string& what, std::string_view array, std::size_t i) {
     if (name.empty()) return;
     auto [it, fresh] = names.emplace(name, what);
-    if (!fresh) ctx.error(where(array, i), indexed(std::string(array), i) + ".name",
+    if (!fresh) ctx.error(where(array, i, "name"), indexed(std::string(array), i) + ".name",
                           "duplicate name \"" + name + "\" (already used by " + it->second + ")");
   };
   for (std::size_t i = 0; i < s.bodies.size(); ++i) claim(s.bodies[i].name, "a body", "bodies", i);
