@@ -29,7 +29,7 @@ constexpr int kPointTypes[] = {7, 5, 9, 13, 11, 6, 4, 8, 12, 10};
 constexpr int kPointTypeCount = static_cast<int>(sizeof(kPointTypes) / sizeof(kPointTypes[0]));
 
 // A gnuplot double-quoted string (backslash escapes processed, "\n" a line break).
-std::string quoted(const std::string& s) {
+std::string gp_string(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
     switch (c) {
@@ -97,7 +97,7 @@ struct Extent {
 std::string axis_commands(char name, const Axis& axis, const Extent& data) {
   std::ostringstream os;
   const std::string a(1, name);
-  os << "set " << a << "label " << quoted(axis.label) << " noenhanced\n";
+  os << "set " << a << "label " << gp_string(axis.label) << " noenhanced\n";
   if (axis.log) {
     os << "set logscale " << a << " 10\n";
     // Power-of-ten labels only when the axis spans a decade; otherwise plain numbers
@@ -117,7 +117,7 @@ std::string axis_commands(char name, const Axis& axis, const Extent& data) {
     os << "set " << a << "tics (";
     for (std::size_t i = 0; i < axis.tics.size(); ++i) {
       if (i > 0) os << ", ";
-      os << quoted(axis.tics[i].second) << ' ' << number(axis.tics[i].first);
+      os << gp_string(axis.tics[i].second) << ' ' << number(axis.tics[i].first);
     }
     os << ")";
     if (axis.tic_rotation != 0) os << " rotate by " << axis.tic_rotation << (name == 'x' ? " right" : "");
@@ -157,7 +157,7 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
   std::ostringstream os;
   os << "set terminal pngcairo enhanced size " << figure.width << ',' << figure.height
      << " font 'Sans,11' linewidth 1\n";
-  os << "set output " << quoted(png.string()) << "\n";
+  os << "set output " << gp_string(png.string()) << "\n";
   os << "set datafile separator whitespace\n";
   os << "set grid xtics ytics mxtics mytics lc rgb '#e4e4e4' lw 1, lc rgb '#f2f2f2' lw 1\n";
   os << "set border lw 1.2\n";
@@ -165,7 +165,7 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
   const bool multi = figure.panels.size() > 1;
   if (multi) {
     os << "set multiplot layout " << figure.panels.size() << ",1";
-    if (!figure.title.empty()) os << " title " << quoted(figure.title) << " font ',13' noenhanced";
+    if (!figure.title.empty()) os << " title " << gp_string(figure.title) << " font ',13' noenhanced";
     os << "\n";
   }
 
@@ -194,7 +194,7 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
                                                                              : figure.title + "\n" + panel.title));
     if (!panel.note.empty()) title += "\n" + panel.note;
     os << "unset label\n";
-    os << "set title " << quoted(title) << " noenhanced font ',12'\n";
+    os << "set title " << gp_string(title) << " noenhanced font ',12'\n";
     os << axis_commands('x', panel.x, ex) << axis_commands('y', panel.y, ey);
     if (panel.key == "off") {
       os << "set key off\n";
@@ -205,7 +205,7 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
     for (std::size_t i = 0; i < panel.labels.size(); ++i) {
       const Label& l = panel.labels[i];
       if (!std::isfinite(l.x) || !std::isfinite(l.y)) continue;
-      os << "set label " << (i + 2) << ' ' << quoted(l.text) << " at " << number(l.x) << ',' << number(l.y)
+      os << "set label " << (i + 2) << ' ' << gp_string(l.text) << " at " << number(l.x) << ',' << number(l.y)
          << " offset 0.6,0.6 font ',10' front noenhanced\n";
     }
 
@@ -216,7 +216,7 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
       const int pt = s.point_type >= 0 ? s.point_type : kPointTypes[auto_point++ % kPointTypeCount];
       if (data[i].empty()) continue;   // nothing drawable: leave it out of the plot
       std::ostringstream p;
-      p << quoted(data_file.string()) << " index " << block << " using 1:2 with " << style_of(s)
+      p << gp_string(data_file.string()) << " index " << block << " using 1:2 with " << style_of(s)
         << " lc rgb '"
         << (s.rgb.empty() ? palette()[static_cast<std::size_t>(colour) % palette().size()] : s.rgb) << "'"
         << " lw " << number(s.line_width) << " dt " << s.dash;
@@ -225,7 +225,7 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
       if (s.title.empty()) {
         p << " notitle";
       } else {
-        p << " title " << quoted(s.title) << " noenhanced";
+        p << " title " << gp_string(s.title) << " noenhanced";
       }
       parts.push_back(p.str());
       ++block;
@@ -263,9 +263,10 @@ void render_png(const Figure& figure, const fs::path& png) {
   fs::create_directories(tmp);
   struct Cleanup {
     fs::path dir;
+    bool keep = false;   // a failed script stays for inspection
     ~Cleanup() {
       std::error_code ec;
-      fs::remove_all(dir, ec);
+      if (!keep) fs::remove_all(dir, ec);
     }
   } cleanup{tmp};
 
@@ -306,7 +307,9 @@ void render_png(const Figure& figure, const fs::path& png) {
     return ss.str();
   };
   if (rc == -1 || !WIFEXITED(rc) || WEXITSTATUS(rc) != 0) {
-    throw PlotError("gnuplot failed drawing " + png.string() + ":\n" + gnuplot_log());
+    cleanup.keep = true;
+    throw PlotError("gnuplot failed drawing " + png.string() + " (script and data kept in " + tmp.string() +
+                    "):\n" + gnuplot_log());
   }
   std::error_code ec;
   if (!fs::exists(out_png) || fs::file_size(out_png, ec) == 0) {
