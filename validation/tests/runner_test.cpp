@@ -1,0 +1,306 @@
+// The runner and comparator, driven by test-double engines so that each behaviour
+// (exact flight, a crash, an exception, a NaN, a hang, an energy gain) is known exactly.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <cmath>
+#include <thread>
+
+#include "physval/validation/comparator.hpp"
+#include "physval/validation/conservation.hpp"
+#include "physval/validation/gate.hpp"
+#include "physval/validation/runner.hpp"
+#include "physval/validation/suite.hpp"
+
+namespace physval {
+namespace {
+
+enum class Fault { None, Crash, Throw, NaN, Hang, GainEnergy };
+
+// Exact ballistic flight x(t) = x0 + v0 t + g t^2 / 2 for every body; reports one
+// contact "a"-"b" at t = 0.5 s when the scene has two bodies.
+class FakeEngine final : public Engine {
+ public:
+  explicit FakeEngine(Fault fault) : fault_(fault) { info_.name = "fake"; info_.version = "1"; }
+  const EngineInfo& info() const override { return info_; }
+  void load(const Scene& scene) override {
+    if (fault_ == Fault::Throw) throw std::runtime_error("cannot load this scene");
+    scene_ = scene;
+  }
+  void step(double dt) override {
+    const double before = t_;
+    t_ += dt;
+    events_.clear();
+    if (scene_.bodies.size() >= 2 && before < 0.5 && t_ >= 0.5) {
+      events_.push_back({{ObjectRef::Kind::Body, 0}, {ObjectRef::Kind::Body, 1}, t_});
+    }
+    if (fault_ == Fault::Crash && t_ > 0.25) std::raise(SIGSEGV);
+    if (fault_ == Fault::Hang && t_ > 0.25) std::this_thread::sleep_for(std::chrono::hours(1));
+  }
+  double time() const override { return t_; }
+  std::size_t body_count() const override { return scene_.bodies.size(); }
+  BodyMeta body_meta(std::size_t i) const override {
+    return {scene_.bodies[i].name, scene_.bodies[i].mass, scene_.bodies[i].radius, scene_.bodies[i].is_static};
+  }
+  void read_states(std::vector<BodyState>& out) const override {
+    out.resize(scene_.bodies.size());
+    const Vec2 g = scene_.world.gravity;
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      const BodyDef& b = scene_.bodies[i];
+      out[i].position = b.position + t_ * b.velocity + 0.5 * t_ * t_ * g;
+      out[i].velocity = b.velocity + t_ * g;
+      if (fault_ == Fault::GainEnergy) out[i].velocity *= 1.0 + t_;   // kinetic energy grows (1 + t)^2
+      if (fault_ == Fault::NaN && t_ > 0.5) out[i].position.x = std::nan("");
+    }
+  }
+  const std::vector<ContactEvent>& contacts() const override { return events_; }
+  std::vector<Setting> settings() const override { return {{"fault", std::to_string(static_cast<int>(fault_))}}; }
+
+ private:
+  Fault fault_;
+  EngineInfo info_;
+  Scene scene_;
+  double t_ = 0.0;
+  std::vector<ContactEvent> events_;
+};
+
+EngineFactory fake(Fault fault) {
+  EngineFactory f;
+  f.info.name = "fake";
+  f.info.version = "1";
+  f.create = [fault] { return std::make_unique<FakeEngine>(fault); };
+  return f;
+}
+
+Scene two_bodies() {
+  Scene s;
+  s.name = "two";
+  s.duration = 1.0;
+  s.dt = 0.01;
+  BodyDef a;
+  a.name = "a";
+  a.radius = 0.5;
+  a.position = {-1.0, 0.0};
+  a.velocity = {1.0, 0.0};
+  BodyDef b = a;
+  b.name = "b";
+  b.position = {1.0, 0.0};
+  b.velocity = {-1.0, 0.0};
+  s.bodies = {a, b};
+  return s;
+}
+
+TEST(Runner, RecordsStepsSamplesContactsAndFinalState) {
+  const Scene s = two_bodies();
+  const RunRecord r = run_engine(s, fake(Fault::None), RunOptions{});
+  EXPECT_EQ(r.status, RunStatus::Ok) << r.reason;
+  EXPECT_EQ(r.steps, 100);
+  ASSERT_EQ(r.contacts.size(), 1u);
+  EXPECT_EQ(r.contacts[0].a, "a");
+  EXPECT_EQ(r.contacts[0].b, "b");
+  EXPECT_NEAR(r.contacts[0].time, 0.5, 1e-12);
+  EXPECT_EQ(r.contacts[0].step, 50);
+  // Samples at t = 0 and at every sample interval, the last at the end.
+  ASSERT_GE(r.series.time.size(), 2u);
+  EXPECT_EQ(r.series.time.front(), 0.0);
+  EXPECT_NEAR(r.series.time.back(), 1.0, 1e-12);
+  ASSERT_EQ(r.final_states.size(), 2u);
+  EXPECT_NEAR(r.final_states[0].position.x, 0.0, 1e-12);
+}
+
+TEST(Runner, SampleIntervalFromScenarioAndMemoryBound) {
+  Scene s = two_bodies();
+  s.sample_interval = 0.1;
+  EXPECT_EQ(sample_every(s, 1'000'000), 10);
+  // 100 steps, 2 bodies, room for 10 states: the interval grows until <= 5 samples fit.
+  s.sample_interval = 0.0;
+  EXPECT_LE(s.steps() / sample_every(s, 10) + 1, 5);
+}
+
+TEST(Runner, CrashCostsOnlyItsOwnRun) {
+  const Scene s = two_bodies();
+  RunOptions o;
+  o.isolate = true;
+  const RunRecord crashed = run_engine_isolated(s, fake(Fault::Crash), o);
+  EXPECT_EQ(crashed.status, RunStatus::Error);
+  EXPECT_NE(crashed.reason.find("signal"), std::string::npos) << crashed.reason;
+  const RunRecord fine = run_engine_isolated(s, fake(Fault::None), o);
+  EXPECT_EQ(fine.status, RunStatus::Ok);
+  // The isolated run carries the same record back as the in-process one.
+  const RunRecord local = run_engine(s, fake(Fault::None), o);
+  ASSERT_EQ(fine.series.time.size(), local.series.time.size());
+  EXPECT_EQ(fine.final_states[1].position, local.final_states[1].position);
+  EXPECT_EQ(fine.contacts.size(), local.contacts.size());
+}
+
+TEST(Runner, ExceptionBecomesErrorWithReason) {
+  const RunRecord r = run_engine_isolated(two_bodies(), fake(Fault::Throw), RunOptions{});
+  EXPECT_EQ(r.status, RunStatus::Error);
+  EXPECT_NE(r.reason.find("cannot load this scene"), std::string::npos) << r.reason;
+}
+
+TEST(Runner, NanIsDivergedWithTheTime) {
+  const RunRecord r = run_engine_isolated(two_bodies(), fake(Fault::NaN), RunOptions{});
+  EXPECT_EQ(r.status, RunStatus::Diverged);
+  ASSERT_TRUE(r.diverged_at);
+  EXPECT_GT(*r.diverged_at, 0.5);
+  EXPECT_LT(r.steps, 100) << "stops at the first non-finite sample";
+}
+
+TEST(Runner, HangIsStoppedByTheTimeout) {
+  RunOptions o;
+  o.timeout_seconds = 1.0;
+  const RunRecord r = run_engine_isolated(two_bodies(), fake(Fault::Hang), o);
+  EXPECT_EQ(r.status, RunStatus::Error);
+  EXPECT_NE(r.reason.find("timed out"), std::string::npos) << r.reason;
+}
+
+TEST(Comparator, EnergyRunawayIsDiverged) {
+  const Scene s = two_bodies();
+  RunRecord r = run_engine(s, fake(Fault::GainEnergy), RunOptions{});
+  ASSERT_EQ(r.status, RunStatus::Ok);
+  compare_run(r, s, Reference{}, false);
+  // Kinetic energy (1 + t)^2 times the initial: drift 3 at t = 1, past the runaway limit of 1.
+  EXPECT_EQ(r.status, RunStatus::Diverged);
+  ASSERT_TRUE(r.metrics["energy_drift"]);
+  EXPECT_NEAR(*r.metrics["energy_drift"], 3.0, 1e-9);
+}
+
+TEST(Comparator, DriftIsNullWhereNotConservedAndZeroForExactFlight) {
+  Scene s = two_bodies();
+  RunRecord r = run_engine(s, fake(Fault::None), RunOptions{});
+  compare_run(r, s, Reference{}, false);
+  ASSERT_TRUE(r.metrics["energy_drift"]);
+  EXPECT_EQ(*r.metrics["energy_drift"], 0.0);
+  EXPECT_EQ(*r.metrics["linear_momentum_drift"], 0.0);
+  s.world.gravity = {0.0, -9.8};   // a uniform field: momentum is not conserved
+  r = run_engine(s, fake(Fault::None), RunOptions{});
+  compare_run(r, s, Reference{}, false);
+  EXPECT_FALSE(r.metrics["linear_momentum_drift"].has_value());
+  ASSERT_TRUE(r.metrics["energy_drift"]);
+  EXPECT_LT(*r.metrics["energy_drift"], 1e-14) << "exact flight conserves KE + PE";
+}
+
+TEST(Comparator, ExpectationsAndGateLimits) {
+  Scene s = two_bodies();
+  s.expect.first_contact = ExpectedContact{"a", "b", 0.5, std::nullopt};
+  s.expect.final_states.push_back({"a", Vec2{0.0, 0.0}, Vec2{1.0, 0.0}, 1e-9});
+  s.gate.limits["energy_drift"] = 1e-12;
+  s.gate.per_engine["fake"]["linear_momentum_drift"] = 0.0;
+  RunRecord r = run_engine(s, fake(Fault::None), RunOptions{});
+  compare_run(r, s, Reference{}, true);
+  EXPECT_TRUE(r.passed());
+  for (const Check& c : r.checks) EXPECT_TRUE(c.pass) << c.what;
+  // A limit tightened below what the engine achieves fails only when gates are enforced.
+  s.expect.final_states[0].position = Vec2{0.1, 0.0};
+  compare_run(r, s, Reference{}, true);
+  EXPECT_FALSE(r.passed());
+  s.expect.final_states[0].position = Vec2{0.0, 0.0};
+  s.gate.limits["energy_drift"] = 1e-12;
+  RunRecord gaining = run_engine(s, fake(Fault::None), RunOptions{});
+  s.gate.limits["first_contact_time"] = 0.1;   // the contact comes at 0.5 s
+  compare_run(gaining, s, Reference{}, false);
+  EXPECT_TRUE(gaining.passed()) << "run reports gate limits but does not enforce them";
+  compare_run(gaining, s, Reference{}, true);
+  EXPECT_FALSE(gaining.passed());
+}
+
+TEST(Comparator, ContactTimingAgainstExpectedContacts) {
+  Scene s = two_bodies();
+  s.expect.contacts.push_back({"a", "b", 0.495, std::nullopt});
+  s.expect.contacts.push_back({"a", "b", 0.9, std::nullopt});   // never happens
+  RunRecord r = run_engine(s, fake(Fault::None), RunOptions{});
+  compare_run(r, s, Reference{}, false);
+  ASSERT_TRUE(r.metrics["contact_time_error"]);
+  EXPECT_NEAR(*r.metrics["contact_time_error"], 0.005, 1e-12);
+  EXPECT_NEAR(*r.metrics["contact_time_error_steps"], 0.5, 1e-9);
+  EXPECT_EQ(*r.metrics["missed_contacts"], 1.0);
+  EXPECT_EQ(*r.metrics["extra_contacts"], 0.0);
+  EXPECT_NEAR(*r.metrics["first_contact_time"], 0.5, 1e-12);
+}
+
+TEST(Comparator, PairOfIdenticalEnginesAgrees) {
+  const Scene s = two_bodies();
+  const RunRecord a = run_engine(s, fake(Fault::None), RunOptions{});
+  const RunRecord b = run_engine(s, fake(Fault::None), RunOptions{});
+  const PairComparison pc = compare_pair(a, b, s);
+  EXPECT_EQ(*pc.metrics.at("position_divergence"), 0.0);
+  EXPECT_EQ(*pc.metrics.at("contact_time_error"), 0.0);
+  EXPECT_EQ(*pc.metrics.at("missed_contacts"), 0.0);
+}
+
+TEST(Conservation, RulesFollowTheScene) {
+  Scene s = two_bodies();
+  Conserved c = conserved_quantities(s);
+  EXPECT_TRUE(c.energy);
+  EXPECT_TRUE(c.linear_momentum);
+  EXPECT_TRUE(c.angular_momentum);
+  s.bodies[0].restitution = 0.5;
+  c = conserved_quantities(s);
+  EXPECT_FALSE(c.energy);
+  EXPECT_TRUE(c.linear_momentum);
+  s.walls.push_back(WallDef{"w", {0, -1}, {0, 1}, {}, 0});
+  c = conserved_quantities(s);
+  EXPECT_FALSE(c.linear_momentum);
+  s.conserves.linear_momentum = true;
+  EXPECT_TRUE(conserved_quantities(s).linear_momentum) << "a scenario may override";
+}
+
+TEST(Conservation, ScalesAreNeverNearZero) {
+  Scene s;
+  BodyDef b;
+  b.name = "resting";
+  b.radius = 0.5;
+  b.position = {0.0, 0.5};
+  s.bodies.push_back(b);
+  s.world.gravity = {0.0, -9.8};
+  const Scales sc = characteristic_scales(s);
+  // A resting body: no kinetic energy, but the field sets a scale m g L.
+  EXPECT_NEAR(sc.energy, 1.0 * 9.8 * std::sqrt(2.0), 1e-12);
+  EXPECT_GT(sc.momentum, 0.0);
+}
+
+TEST(Gate, JunitHasACasePerScenarioAndEngine) {
+  SuiteResult result;
+  ScenarioResult sr;
+  sr.scene = two_bodies();
+  RunRecord ok = run_engine(sr.scene, fake(Fault::None), RunOptions{});
+  RunRecord bad = ok;
+  bad.engine = "other<&>";
+  bad.checks.push_back({"energy_drift", 1e-9, 1.0, false, true});
+  RunRecord skipped = unsupported_run(sr.scene, fake(Fault::None).info, {"particles"});
+  sr.runs = {ok, bad, skipped};
+  result.scenarios.push_back(sr);
+  const std::string xml = junit_xml(result);
+  EXPECT_NE(xml.find("tests=\"3\" failures=\"1\""), std::string::npos) << xml;
+  EXPECT_NE(xml.find("name=\"other&lt;&amp;&gt;\""), std::string::npos);
+  EXPECT_NE(xml.find("<skipped message=\"cannot model: particles\"/>"), std::string::npos);
+  EXPECT_NE(xml.find("energy_drift = 1 &gt; limit 1e-09"), std::string::npos) << xml;
+}
+
+TEST(Gate, BaselineFailsOnRegressionBeyondFactor) {
+  SuiteResult result;
+  ScenarioResult sr;
+  sr.scene = two_bodies();
+  RunRecord r = run_engine(sr.scene, fake(Fault::None), RunOptions{});
+  r.metrics["energy_drift"] = 3e-6;
+  r.metrics["position_divergence"] = 1e-3;
+  sr.runs = {r};
+  result.scenarios.push_back(sr);
+  const nlohmann::json baseline = {
+      {"runs", {{{"scenario", "two"}, {"engine", "fake"}, {"metrics", {{"energy_drift", 1e-6}, {"position_divergence", 1e-3}}}}}}};
+  EXPECT_EQ(apply_baseline(result, baseline, 2.0), 1);
+  const auto& checks = result.scenarios[0].runs[0].checks;
+  ASSERT_EQ(checks.size(), 2u);
+  for (const Check& c : checks) {
+    if (c.what == "baseline.energy_drift") {
+      EXPECT_FALSE(c.pass) << "3e-6 > 2 x 1e-6";
+    }
+    if (c.what == "baseline.position_divergence") {
+      EXPECT_TRUE(c.pass);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace physval
