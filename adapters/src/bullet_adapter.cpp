@@ -32,7 +32,8 @@ constexpr const char* kEngineName = "bullet";
 constexpr double kEveryPenetration = 1.0e30;
 // Half-depth along z of the static boxes: any positive value works, spheres stay at z = 0.
 constexpr double kHalfDepthZ = 1.0;
-// Bullet rotates a body by at most this angle per step (btTransformUtil::integrateTransform).
+// Above this rotation per step btTransformUtil::integrateTransform limits the angle it
+// integrates: at 100 rad/s and dt 1/60 a body turns 1.44 rad instead of 1.67.
 constexpr double kAngularMotionThreshold = 0.25 * SIMD_PI;
 
 std::string bullet_version() {
@@ -468,7 +469,8 @@ void BulletEngine::check_limits(double dt) {
     if (spin * dt > kAngularMotionThreshold) {
       limits_.hit("spin_clamp", time_, [&] {
         return "body '" + name + "' spins at " + fmt(spin) +
-               " rad/s; Bullet integrates at most pi/4 rad of rotation per step (ANGULAR_MOTION_THRESHOLD)";
+               " rad/s, over pi/4 rad per step: Bullet's integrateTransform limits the rotation "
+               "(ANGULAR_MOTION_THRESHOLD) and the angle no longer advances by w dt";
       });
     }
     const double travel = static_cast<double>(body.getLinearVelocity().length()) * dt;

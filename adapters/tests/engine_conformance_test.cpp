@@ -297,6 +297,163 @@ TEST_P(Conformance, EveryOptionIsDocumentedAndReportedInSettings) {
   EXPECT_EQ(setting(settings, "version"), f->info.version);
 }
 
+// --- forces applied from forces.hpp -----------------------------------------------
+
+// Semi-implicit Euler in double with the forces of forces.hpp: what core computes and
+// what each adapter hands its engine every step as an external force.
+std::vector<BodyState> predict_free_flight(const Scene& s, int steps) {
+  std::vector<BodyState> st;
+  for (const BodyDef& b : s.bodies) st.push_back({b.position, b.velocity, b.angle, b.angular_velocity, true});
+  WorldDef field_free = s.world;
+  field_free.gravity = {};
+  std::vector<Vec2> f(st.size());
+  std::vector<Vec2> pos(st.size());
+  std::vector<double> mass(st.size());
+  for (int n = 0; n < steps; ++n) {
+    for (std::size_t i = 0; i < st.size(); ++i) {
+      f[i] = body_force(s.bodies[i], field_free, st[i].velocity, st[i].angle);
+      pos[i] = st[i].position;
+      mass[i] = s.bodies[i].mass;
+    }
+    if (s.world.newtonian) add_newtonian_forces(s.world.G, s.world.softening, pos, mass, f);
+    for (std::size_t i = 0; i < st.size(); ++i) {
+      if (s.bodies[i].is_static) continue;
+      st[i].velocity += s.dt * (s.world.gravity + f[i] / s.bodies[i].mass);
+      st[i].position += s.dt * st[i].velocity;
+    }
+  }
+  return st;
+}
+
+TEST_P(Conformance, ExternalForcesFollowTheSharedForceModels) {
+  // Drag towards a wind (linear and quadratic), a thrust table along the heading, and
+  // Newtonian attraction between two heavy bodies (a static one attracts, takes nothing).
+  Scene s = empty_scene("forces", 1.0 / 60.0, 2.0);
+  s.world.gravity = {0.0, -9.81};
+  s.world.wind = {2.0, 0.5};
+  s.world.newtonian = true;
+  s.world.G = 1.0;   // a toy constant so that the attraction is of the other forces' size
+  s.world.softening = 0.1;
+  BodyDef kite = circle("kite", 0.1, 0.5, {0.0, 0.0}, {1.0, 4.0});
+  kite.drag_linear = 0.3;
+  kite.drag_quadratic = 0.05;
+  BodyDef car = circle("car", 0.2, 2.0, {0.0, -20.0}, {0.5, 0.0});
+  car.angle = 0.3;
+  car.thrust.speeds = {0.0, 5.0, 10.0};
+  car.thrust.gears = {1.0, 2.0};
+  car.thrust.accel = {{3.0, 2.0, 0.5}, {2.0, 2.5, 1.5}};
+  car.thrust.gear = 1.4;
+  car.thrust.throttle = 0.8;
+  BodyDef sun = circle("sun", 0.3, 5.0, {6.0, -10.0}, {0.0, 0.0});
+  sun.is_static = true;
+  s.bodies = {kite, car, sun};
+  auto e = make_engine(traits().name, s);
+  run(*e, s, s.steps());
+  const auto got = states(*e);
+  const auto want = predict_free_flight(s, s.steps());
+  // Bullet runs the very recursion in double: 1e-9 m. Box2D holds states and forces in
+  // float: each of the 120 steps rounds about 8 operations at relative 2^-24, on
+  // positions up to ~30 m and velocities up to ~20 m/s: 120 * 8 * 6e-8 * 30 = 2e-3 m.
+  const double pos_tol = traits().float32 ? 120 * 8 * traits().unit_roundoff * 30.0 : 1e-9;
+  const double vel_tol = traits().float32 ? 120 * 8 * traits().unit_roundoff * 20.0 : 1e-9;
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(got[i].position.x, want[i].position.x, pos_tol) << s.bodies[i].name;
+    EXPECT_NEAR(got[i].position.y, want[i].position.y, pos_tol) << s.bodies[i].name;
+    EXPECT_NEAR(got[i].velocity.x, want[i].velocity.x, vel_tol) << s.bodies[i].name;
+    EXPECT_NEAR(got[i].velocity.y, want[i].velocity.y, vel_tol) << s.bodies[i].name;
+  }
+  // The forces mattered: without them the kite would have flown elsewhere.
+  Scene bare = s;
+  bare.world.newtonian = false;
+  bare.bodies[0].drag_linear = bare.bodies[0].drag_quadratic = 0.0;
+  bare.bodies[1].thrust = {};
+  const auto without = predict_free_flight(bare, s.steps());
+  EXPECT_GT(length(without[0].position - want[0].position), 1.0);
+  EXPECT_GT(length(without[1].position - want[1].position), 1.0);
+}
+
+// --- static shapes ----------------------------------------------------------------
+
+TEST_P(Conformance, BoxesSurfacesAndPointsBounce) {
+  // A ball onto a box's top face, a ball onto a surface from its normals' side, and a
+  // point onto a static circle: each bounces (e = 1, 3 m/s) and reports its pair.
+  Scene s = empty_scene("statics", 1.0 / 120.0, 1.0);
+  s.bodies.push_back(circle("on_box", 0.25, 1.0, {-6.0, 1.63}, {0.0, -3.0}));
+  s.bodies.push_back(circle("on_surface", 0.25, 1.0, {0.0, 1.63}, {0.0, -3.0}));
+  BodyDef point = circle("point", 0.0, 0.1, {6.0, 1.63}, {0.0, -3.0});
+  point.shape = ShapeKind::Point;
+  s.bodies.push_back(point);
+  BodyDef post = circle("post", 0.5, 1.0, {6.0, 0.0}, {0.0, 0.0});
+  post.is_static = true;
+  s.bodies.push_back(post);
+  BoxDef box;
+  box.name = "block";
+  box.min = {-7.0, -1.0};
+  box.max = {-5.0, 0.5};
+  s.boxes.push_back(box);
+  SurfaceDef surf;
+  surf.name = "ramp";
+  // A valley with a flat floor; normals up (the left of the point order).
+  surf.points = {{-3.0, 0.8}, {-1.0, 0.5}, {1.0, 0.5}, {3.0, 0.8}};
+  for (std::size_t k = 0; k < surf.points.size(); ++k) surf.normals.push_back({0.0, 1.0});
+  s.surfaces.push_back(surf);
+  auto e = make_engine(traits().name, s);
+  const auto events = run(*e, s, s.steps());
+  const auto st = states(*e);
+  auto saw = [&](std::uint32_t body, ObjectRef other) {
+    for (const ContactEvent& c : events) {
+      if (c.a == ObjectRef{ObjectRef::Kind::Body, body} && c.b == other) return true;
+    }
+    return false;
+  };
+  EXPECT_TRUE(saw(0, {ObjectRef::Kind::Box, 0}));
+  EXPECT_TRUE(saw(1, {ObjectRef::Kind::Surface, 0}));
+  EXPECT_TRUE(saw(2, {ObjectRef::Kind::Body, 3}));
+  // Elastic, frictionless, head-on onto horizontal faces: they leave upwards at 3 m/s.
+  EXPECT_NEAR(st[0].velocity.y, 3.0, 1e-5);
+  EXPECT_NEAR(st[1].velocity.y, 3.0, 1e-5);
+  EXPECT_NEAR(st[2].velocity.y, 3.0, 1e-5);
+  EXPECT_EQ(st[3].position, (Vec2{6.0, 0.0}));   // a static body stays put
+  EXPECT_EQ(e->body_meta(3).mass, 0.0);
+  EXPECT_TRUE(e->body_meta(3).is_static);
+}
+
+// --- the collision matrix ----------------------------------------------------------
+
+TEST_P(Conformance, CollisionMatrixIgnoreEventDestroy) {
+  auto scene_with = [](CollisionResponse response) {
+    Scene s = head_on(1.0, 1.0, 1.0, -1.0, 1.0 / 60.0);
+    s.bodies[0].group = "ball";
+    s.bodies[1].group = "brick";
+    s.collision_matrix.push_back({"ball", "brick", response});
+    return s;
+  };
+  {  // ignore: they pass through each other, nothing reported
+    const Scene s = scene_with(CollisionResponse::Ignore);
+    auto e = make_engine(traits().name, s);
+    EXPECT_TRUE(run(*e, s, s.steps()).empty());
+    EXPECT_EQ(states(*e)[0].velocity.x, 1.0);
+    EXPECT_EQ(states(*e)[1].velocity.x, -1.0);
+  }
+  {  // event: they pass through, one contact reported
+    const Scene s = scene_with(CollisionResponse::Event);
+    auto e = make_engine(traits().name, s);
+    EXPECT_EQ(run(*e, s, s.steps()).size(), 1u);
+    EXPECT_EQ(states(*e)[0].velocity.x, 1.0);
+    EXPECT_EQ(states(*e)[1].velocity.x, -1.0);
+  }
+  {  // destroy the brick (group b): the ball bounces off it, the brick is gone
+    const Scene s = scene_with(CollisionResponse::DestroyB);
+    auto e = make_engine(traits().name, s);
+    EXPECT_EQ(run(*e, s, s.steps()).size(), 1u);
+    const auto st = states(*e);
+    EXPECT_TRUE(st[0].alive);
+    EXPECT_FALSE(st[1].alive);
+    EXPECT_NEAR(st[0].velocity.x, -1.0, 1e-6);
+    EXPECT_EQ(e->body_count(), 2u);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Adapters, Conformance,
                          ::testing::Values(EngineTraits{"box2d", 0x1p-24, true}, EngineTraits{"bullet", 0x1p-53, false}),
                          traits_name);
