@@ -1,0 +1,175 @@
+// The core engine: the Engine interface over core's world, and the step pipeline.
+#include "physval/core/core_engine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "world.hpp"
+
+namespace physval {
+
+using core_detail::CollisionMode;
+using core_detail::World;
+
+namespace {
+
+EngineInfo make_info() {
+  EngineInfo info;
+  info.name = "core";
+  info.version = "0.1.0";
+  info.precision = Precision::Float64;
+  info.summary =
+      "physval's lecture-model engine: double precision, exact event-driven impacts "
+      "(or the lecture's one-pass scheme), four integrators, four broad phases";
+  for (int f = 0; f < static_cast<int>(Feature::Count); ++f) info.features.push_back(static_cast<Feature>(f));
+  info.options = core_detail::core_option_specs();
+  return info;
+}
+
+const EngineInfo& core_info() {
+  static const EngineInfo info = make_info();
+  return info;
+}
+
+}  // namespace
+
+EngineFactory core_engine_factory() {
+  EngineFactory f;
+  f.info = core_info();
+  f.create = [] { return std::make_unique<CoreEngine>(); };
+  return f;
+}
+
+double particle_intensity(double age, double lifetime) {
+  if (!(lifetime > 0.0)) return 0.0;
+  return std::clamp(1.0 - age / lifetime, 0.0, 1.0);
+}
+
+CoreEngine::CoreEngine() : world_(std::make_unique<World>()) {}
+CoreEngine::~CoreEngine() = default;
+
+const EngineInfo& CoreEngine::info() const { return core_info(); }
+
+void CoreEngine::load(const Scene& scene) {
+  auto w = std::make_unique<World>();
+  core_detail::load_world(*w, scene);
+  world_ = std::move(w);
+}
+
+// One step: a pipeline of named stages, each present only when the scene needs it.
+void CoreEngine::step(double dt) {
+  if (!(dt >= 0.0) || !std::isfinite(dt)) throw std::invalid_argument("core: step dt must be finite and >= 0");
+  World& w = *world_;
+  w.contacts.clear();
+  w.stats = {};
+  if (dt == 0.0) return;
+  core_detail::StepContext ctx;
+  ctx.t0 = w.time;
+  ctx.dt = dt;
+  ctx.event_cap = w.max_events_option > 0 ? w.max_events_option
+                                          : 1000 + 100 * static_cast<std::int64_t>(w.size());
+  const bool exact = w.mode == CollisionMode::Exact;
+
+  // 1. forces: accelerations at the start of the step
+  if (w.any_forces) core_detail::compute_accelerations(w, w.pos, w.vel, w.acc);
+  // 2. resting contacts: the support takes the normal force; friction along it
+  if (w.any_forces && exact) core_detail::apply_supports(w, ctx);
+  // 3. integrator: start-of-step kicks and each body's path over the step
+  core_detail::begin_paths(w, ctx);
+  // 4. collisions: exact impacts one by one, or the lecture's one pass
+  if (exact) {
+    core_detail::collide_exact(w, ctx);
+  } else {
+    core_detail::collide_lecture(w, ctx, 0.0);
+  }
+  // 5. integrator: everyone to the end of the step, end-of-step corrections
+  core_detail::end_paths(w, ctx);
+  // 6. particles: explosions and trails spawn, lives end
+  if (!w.emitters.empty()) core_detail::finish_particles(w, ctx);
+
+  w.time = ctx.t0 + dt;
+}
+
+double CoreEngine::time() const { return world_->time; }
+
+std::size_t CoreEngine::body_count() const { return world_->size(); }
+
+BodyMeta CoreEngine::body_meta(std::size_t i) const {
+  const World& w = *world_;
+  BodyMeta m;
+  const auto k = static_cast<std::uint32_t>(i);
+  if (i < w.scene_bodies) {
+    m.name = w.names[i];
+  } else {
+    const std::size_t p = i - w.scene_bodies;
+    m.name = w.emitters[w.emitter_of[p]].def.name + "#" + std::to_string(w.serial[p]);
+  }
+  m.is_static = w.is_static(k);
+  m.mass = m.is_static ? 0.0 : 1.0 / w.inv_mass[i];
+  m.radius = w.radius[i];
+  return m;
+}
+
+void CoreEngine::read_states(std::vector<BodyState>& out) const {
+  const World& w = *world_;
+  out.resize(w.size());
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    BodyState& s = out[i];
+    s.position = w.pos[i];
+    s.velocity = w.vel[i];
+    s.angle = w.angle.empty() ? 0.0 : w.angle[i];
+    s.angular_velocity = 0.0;   // bodies do not spin (lecture step 6)
+    s.alive = w.alive(static_cast<std::uint32_t>(i));
+  }
+}
+
+const std::vector<ContactEvent>& CoreEngine::contacts() const { return world_->contacts; }
+
+std::vector<Setting> CoreEngine::settings() const {
+  const World& w = *world_;
+  std::vector<Setting> s;
+  s.emplace_back("integrator", core_detail::integrator_name(w.integrator));
+  s.emplace_back("collision", w.mode == CollisionMode::Exact ? "exact" : "lecture");
+  s.emplace_back("broadphase", std::string(broadphase_name(w.broadphase)) + (w.broadphase_auto ? " (auto)" : ""));
+  s.emplace_back("cell_size", w.cell_size > 0.0 ? option_value_to_string(w.cell_size) : "auto");
+  s.emplace_back("max_events_per_step",
+                 w.max_events_option > 0 ? std::to_string(w.max_events_option)
+                                         : std::to_string(1000 + 100 * static_cast<std::int64_t>(w.size())) + " (auto)");
+  s.emplace_back("rest_speed", w.rest_speed_option > 0.0
+                                   ? option_value_to_string(w.rest_speed_option)
+                                   : "auto (" + option_value_to_string(w.rest_factor) + " |a_n| dt)");
+  s.emplace_back("precision", "float64");
+  return s;
+}
+
+std::vector<std::string> CoreEngine::limits_hit() const {
+  const World& w = *world_;
+  std::vector<std::string> out;
+  if (w.cap_hits > 0) {
+    std::ostringstream os;
+    os << "event cap reached in " << w.cap_hits << " step(s), first at t = " << w.first_cap_time
+       << " s; the rest of each such step was finished by the lecture pass (max_events_per_step)";
+    out.push_back(os.str());
+  }
+  return out;
+}
+
+double CoreEngine::particle_age(std::size_t i) const {
+  const World& w = *world_;
+  if (i < w.scene_bodies || i >= w.size()) return -1.0;
+  return w.time - w.birth[i - w.scene_bodies];
+}
+
+double CoreEngine::particle_intensity(std::size_t i) const {
+  const World& w = *world_;
+  if (i < w.scene_bodies || i >= w.size()) return 1.0;
+  return physval::particle_intensity(particle_age(i), w.lifetime[i - w.scene_bodies]);
+}
+
+const CoreStepStats& CoreEngine::last_step_stats() const { return world_->stats; }
+
+std::size_t CoreEngine::memory_bytes() const { return world_->memory_bytes(); }
+
+}  // namespace physval

@@ -1,0 +1,390 @@
+// Exact (event-driven) collisions: within a step, advance to the earliest impact,
+// resolve it, and continue for the rest of the step from there, so nothing tunnels at
+// any speed and a contact's time is the root of its gap polynomial, not the step's end.
+//
+// Every body keeps its own clock (tloc) and is advanced lazily, only when an event
+// involves it. Candidate events sit in a min-heap ordered by (time, kind, bodies), so
+// the order is total and runs are bit-identical. An event is stale once a body it
+// names has changed its path since (each body carries a version). After an impact the
+// bodies involved register a box over their new path with the broad phase and are
+// tested against whatever it overlaps.
+//
+// Termination: an impact leaves its pair separating; pressing contacts settle into
+// resting contact on a face or micro-bounce with a flight of at least 1/8 step; a
+// step processes at most max_events_per_step events, and at the cap the rest of the
+// step is finished with the lecture pass (reported in limits_hit).
+#include <algorithm>
+#include <cmath>
+
+#include "physval/core/time_of_impact.hpp"
+#include "world.hpp"
+
+namespace physval::core_detail {
+
+Aabb path_box(const World& w, std::uint32_t i, double t, double T) {
+  const double r = w.radius[i];
+  const Vec2 p = w.pos_at(i, t);
+  if (w.is_static(i)) return make_aabb(p.x - r, p.y - r, p.x + r, p.y + r);
+  const Vec2 v = w.vel_at(i, t);
+  const Vec2 a = w.path_acc(i);
+  const double s = T - t;
+  const Vec2 e = p + s * v + (0.5 * s * s) * a;
+  double lo_x = std::min(p.x, e.x), hi_x = std::max(p.x, e.x);
+  double lo_y = std::min(p.y, e.y), hi_y = std::max(p.y, e.y);
+  // A parabola can turn back within the step: include its extremum on each axis.
+  if (a.x != 0.0) {
+    const double sx = -v.x / a.x;
+    if (sx > 0.0 && sx < s) {
+      const double x = p.x + sx * v.x + 0.5 * sx * sx * a.x;
+      lo_x = std::min(lo_x, x);
+      hi_x = std::max(hi_x, x);
+    }
+  }
+  if (a.y != 0.0) {
+    const double sy = -v.y / a.y;
+    if (sy > 0.0 && sy < s) {
+      const double y = p.y + sy * v.y + 0.5 * sy * sy * a.y;
+      lo_y = std::min(lo_y, y);
+      hi_y = std::max(hi_y, y);
+    }
+  }
+  return make_aabb(lo_x - r, lo_y - r, hi_x + r, hi_y + r);
+}
+
+namespace {
+
+bool later(const Event& x, const Event& y) {
+  if (x.time != y.time) return x.time > y.time;
+  if (x.kind != y.kind) return x.kind > y.kind;
+  if (x.a != y.a) return x.a > y.a;
+  if (x.b != y.b) return x.b > y.b;
+  if (x.feature != y.feature) return x.feature > y.feature;
+  if (x.va != y.va) return x.va > y.va;
+  return x.vb > y.vb;
+}
+
+double inf_norm(Vec2 v) { return std::max(std::fabs(v.x), std::fabs(v.y)); }
+
+class EventLoop {
+ public:
+  EventLoop(World& w, StepContext& ctx) : w_(w), ctx_(ctx), T_(ctx.dt) {}
+
+  void run() {
+    prune_passing(w_);
+    w_.heap.clear();
+    const std::size_t n = w_.size();
+    std::span<Aabb> boxes = w_.bp->prepare(n);
+    w_.active.resize(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      w_.active[i] = w_.alive(i) ? 1 : 0;
+      if (w_.active[i]) boxes[i] = path_box(w_, i, 0.0, T_);
+    }
+    w_.bp->build(w_.active);
+    w_.pairs.clear();
+    w_.bp->pairs(w_.pairs);
+    w_.stats.candidate_pairs = static_cast<std::int64_t>(w_.pairs.size());
+    for (const BodyPair& p : w_.pairs) schedule_pair(p.a, p.b, 0.0);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      if (!w_.dynamic(i)) continue;
+      schedule_statics(i, 0.0, w_.bp->box(i));
+      schedule_body(i, 0.0);
+    }
+    if (!w_.emitters.empty()) {
+      schedule_explosions(w_, ctx_, w_.heap);
+      std::make_heap(w_.heap.begin(), w_.heap.end(), later);
+    }
+
+    while (!w_.heap.empty()) {
+      std::pop_heap(w_.heap.begin(), w_.heap.end(), later);
+      const Event e = w_.heap.back();
+      w_.heap.pop_back();
+      if (!valid(e)) continue;
+      if (ctx_.events >= ctx_.event_cap) {
+        finish_with_lecture_pass(e.time);
+        return;
+      }
+      ++ctx_.events;
+      process(e);
+    }
+  }
+
+ private:
+  void push(const Event& e) {
+    w_.heap.push_back(e);
+    std::push_heap(w_.heap.begin(), w_.heap.end(), later);
+  }
+
+  bool valid(const Event& e) const {
+    if (!w_.alive(e.a)) return false;
+    switch (e.kind) {
+      case EventKind::Pair: return w_.alive(e.b) && w_.version[e.a] == e.va && w_.version[e.b] == e.vb;
+      case EventKind::Static:
+      case EventKind::Stop:
+      case EventKind::Leave: return w_.version[e.a] == e.va;
+      case EventKind::Explode:
+      case EventKind::Expire: return true;
+    }
+    return false;
+  }
+
+  bool related(std::uint32_t i, std::uint32_t j) const {
+    // A particle never collides with the body that emitted it.
+    const std::size_t s = w_.scene_bodies;
+    if ((w_.flags[i] & kParticle) && w_.parent[i - s] == j) return true;
+    if ((w_.flags[j] & kParticle) && w_.parent[j - s] == i) return true;
+    return false;
+  }
+
+  void schedule_pair(std::uint32_t i, std::uint32_t j, double t) {
+    if (i == j) return;
+    const std::uint8_t fi = w_.flags[i], fj = w_.flags[j];
+    if (!(fi & kAlive) || !(fj & kAlive)) return;
+    if ((fi & kStatic) && (fj & kStatic)) return;
+    if ((fi & kPoint) && (fj & kPoint)) return;
+    if (((fi | fj) & kParticle) && related(i, j)) return;
+    if (i > j) std::swap(i, j);
+    if (w_.any_rules) {
+      const PairResponse& r = w_.response(w_.group[i], w_.group[j]);
+      if (!r.collide && !r.event) return;
+      if (!r.collide && is_passing(w_, pair_key(i, j))) return;
+    }
+    const Vec2 pi = w_.pos_at(i, t), pj = w_.pos_at(j, t);
+    const Vec2 vi = w_.vel_at(i, t), vj = w_.vel_at(j, t);
+    const Vec2 dv = vj - vi;
+    const Vec2 da = w_.path_acc(j) - w_.path_acc(i);
+    const double R = w_.radius[i] + w_.radius[j];
+    const double scale = inf_norm(pi) + inf_norm(pj) + R;
+    const double speed = length(dv) + length(da) * (T_ - t);
+    const double s = toi::circle_circle(pj - pi, dv, da, R, T_ - t, toi::squared_tolerance(scale, speed, R));
+    if (s == toi::kNever) return;
+    push({t + s, i, j, w_.version[i], w_.version[j], EventKind::Pair, 0});
+  }
+
+  void schedule_statics(std::uint32_t i, double t, const Aabb& box) {
+    if (w_.statics.segments.empty()) return;
+    w_.found_static.clear();
+    w_.statics.query(box, w_.found_static);
+    if (w_.found_static.empty()) return;
+    const Vec2 p = w_.pos_at(i, t), v = w_.vel_at(i, t), a = w_.path_acc(i);
+    for (std::uint32_t k : w_.found_static) {
+      const Segment& seg = w_.statics.segments[k];
+      if (w_.any_rules) {
+        const PairResponse& r = w_.response(w_.group[i], seg.group);
+        if (!r.collide && !r.event) continue;
+        if (!r.collide && is_passing(w_, static_key(i, k))) continue;
+      }
+      const toi::SegmentHit hit =
+          toi::circle_segment(p, v, a, w_.radius[i], seg.from, seg.to, T_ - t, w_.length_scale);
+      if (hit.s == toi::kNever) continue;
+      push({t + hit.s, i, k, w_.version[i], 0, EventKind::Static, static_cast<std::uint8_t>(hit.cap ? 1 : 0)});
+    }
+  }
+
+  void schedule_body(std::uint32_t i, double t) {
+    if (w_.supported(i)) {
+      const double stop = support_stop_time(w_, i, t, T_);
+      if (stop != toi::kNever) push({stop, i, 0, w_.version[i], 0, EventKind::Stop, 0});
+      const double leave = support_leave_time(w_, i, t, T_);
+      if (leave != toi::kNever) push({leave, i, 0, w_.version[i], 0, EventKind::Leave, 0});
+    }
+    if (w_.flags[i] & kParticle) {
+      const std::size_t k = i - w_.scene_bodies;
+      const double death = w_.birth[k] + w_.lifetime[k] - ctx_.t0;
+      if (death <= T_) push({std::max(death, t), i, 0, w_.version[i], 0, EventKind::Expire, 0});
+    }
+  }
+
+  // Body i's path changed at time t: register its new path and find its next events.
+  void reschedule(std::uint32_t i, double t, std::uint32_t exclude) {
+    if (!w_.alive(i)) return;
+    const Aabb box = path_box(w_, i, t, T_);
+    w_.bp->grow(i, box);
+    w_.found.clear();
+    w_.bp->query(i, w_.found);
+    for (std::uint32_t j : w_.found) {
+      if (j != exclude) schedule_pair(i, j, t);
+    }
+    if (w_.dynamic(i)) schedule_statics(i, t, box);
+    schedule_body(i, t);
+  }
+
+  // A velocity change by another body: a supported body lifted off (or driven into)
+  // its support is released; otherwise its friction is re-evaluated.
+  void after_velocity_change(std::uint32_t i) {
+    if (!w_.supported(i)) return;
+    const double vn = dot(w_.vel[i], w_.support_n[i]);
+    const double tol = 1e-12 * (length(w_.vel[i]) + 1e-300);
+    if (std::fabs(vn) > tol) {
+      release_support(w_, i);
+    } else {
+      support_path(w_, i);
+    }
+  }
+
+  void destroy_after(std::uint32_t i, bool by_rule) {
+    if (by_rule || (w_.flags[i] & kDestroyOnHit)) kill_body(w_, i);
+  }
+
+  void process(const Event& e) {
+    const double t_abs = ctx_.t0 + e.time;
+    switch (e.kind) {
+      case EventKind::Pair: process_pair(e.a, e.b, e.time, t_abs); break;
+      case EventKind::Static: process_static(e.a, e.b, e.feature, e.time, t_abs); break;
+      case EventKind::Stop:
+        w_.advance(e.a, e.time);
+        w_.vel[e.a] = {};
+        support_path(w_, e.a);
+        ++w_.version[e.a];
+        reschedule(e.a, e.time, kNone);
+        break;
+      case EventKind::Leave:
+        w_.advance(e.a, e.time);
+        release_support(w_, e.a);
+        ++w_.version[e.a];
+        reschedule(e.a, e.time, kNone);
+        break;
+      case EventKind::Expire:
+        w_.advance(e.a, e.time);
+        kill_body(w_, e.a);
+        break;
+      case EventKind::Explode:
+        w_.advance(e.a, e.time);
+        explode_parent(w_, e.b, t_abs);
+        break;
+    }
+  }
+
+  void process_pair(std::uint32_t i, std::uint32_t j, double t, double t_abs) {
+    w_.advance(i, t);
+    w_.advance(j, t);
+    ++w_.stats.impacts;
+    const PairResponse& r = w_.response(w_.group[i], w_.group[j]);
+    if (!r.collide) {   // "event": pass through, report once
+      if (r.event) record_contact(w_, i, j, nullptr, t_abs, ctx_.dt);
+      add_passing(w_, pair_key(i, j));
+      return;
+    }
+    const Vec2 d = w_.pos[j] - w_.pos[i];
+    const double dl = length(d);
+    const Vec2 n = dl > 0.0 ? d / dl : Vec2{1.0, 0.0};
+    const PairMaterial m = w_.pair_material(w_.material[i], w_.material[j]);
+    double min_sep = 0.0;
+    if (w_.any_forces) {
+      // Pressed together (relative acceleration closing) and too slow to bounce clear:
+      // a micro-bounce with a flight of at least ~1/8 step instead of endless impacts.
+      const double an = dot(w_.effective_acc(j) - w_.effective_acc(i), n);
+      const double vn = dot(w_.vel[j] - w_.vel[i], n);
+      if (an < 0.0) {
+        const double vr = w_.rest_speed(an, ctx_.dt);
+        if (m.restitution * std::max(0.0, -vn) < vr) min_sep = 0.5 * vr;
+      }
+    }
+    resolve_pair(w_, i, j, n, m, min_sep);
+    after_velocity_change(i);
+    after_velocity_change(j);
+    if (r.event) record_contact(w_, i, j, nullptr, t_abs, ctx_.dt);
+    ++w_.version[i];
+    ++w_.version[j];
+    destroy_after(i, r.destroy_first);
+    destroy_after(j, r.destroy_second);
+    reschedule(i, t, kNone);
+    reschedule(j, t, i);
+  }
+
+  void process_static(std::uint32_t i, std::uint32_t k, std::uint8_t feature, double t, double t_abs) {
+    w_.advance(i, t);
+    ++w_.stats.impacts;
+    const Segment& seg = w_.statics.segments[k];
+    const PairResponse& r = w_.response(w_.group[i], seg.group);
+    if (!r.collide) {
+      if (r.event) record_contact(w_, i, kNone, &seg, t_abs, ctx_.dt);
+      add_passing(w_, static_key(i, k));
+      return;
+    }
+    const Vec2 p = w_.pos[i];
+    const bool face = feature == 0;
+    Vec2 n;
+    if (face) {
+      const double D = dot(p - seg.from, seg.normal);
+      const double tiny = 1e-9 * w_.radius[i] + 1e-15 * w_.length_scale;
+      double side;
+      if (D > tiny) side = 1.0;
+      else if (D < -tiny) side = -1.0;
+      else side = dot(w_.vel[i], seg.normal) < 0.0 ? 1.0 : -1.0;
+      n = side * seg.normal;
+    } else {
+      const double u = dot(p - seg.from, seg.dir);
+      const Vec2 q = u <= 0.0 ? seg.from : seg.to;
+      n = normalized(p - q);
+      if (length_squared(n) == 0.0) n = u <= 0.0 ? -seg.dir : seg.dir;
+    }
+    // The response normal: a surface's precomputed normals, interpolated along the piece.
+    Vec2 n_resp = n;
+    if (face && (seg.normal_from.x != 0.0 || seg.normal_from.y != 0.0)) {
+      const double f = std::clamp(dot(p - seg.from, seg.dir) / seg.length, 0.0, 1.0);
+      Vec2 nn = normalized((1.0 - f) * seg.normal_from + f * seg.normal_to);
+      if (dot(nn, n) < 0.0) nn = -nn;
+      if (length_squared(nn) > 0.0) n_resp = nn;
+    }
+    const PairMaterial m = w_.pair_material(w_.material[i], seg.material);
+    const double vn = dot(w_.vel[i], n);
+    const double an = dot(w_.effective_acc(i), n);
+    const bool pressed = w_.any_forces && an < 0.0;
+    const double vr = pressed ? w_.rest_speed(an, ctx_.dt) : 0.0;
+    const bool slow = pressed && m.restitution * std::max(0.0, -vn) < vr;
+    const bool own_support = w_.supported(i) && w_.support[i] == k;
+    if (slow && face && (!w_.supported(i) || own_support)) {
+      // Settle: the normal velocity goes (friction impulse included), and the body
+      // rests on this face until it is lifted, pulled away or slides off its end.
+      PairMaterial inelastic = m;
+      inelastic.restitution = 0.0;
+      resolve_static(w_, i, n, inelastic, 0.0);
+      w_.support[i] = k;
+      w_.support_n[i] = n;
+      support_path(w_, i);
+    } else {
+      resolve_static(w_, i, n_resp, m, slow ? 0.5 * vr : 0.0);
+      // An interpolated normal must still send the body away from the segment.
+      if (dot(w_.vel[i], n) < 0.0) resolve_static(w_, i, n, m, 0.0);
+      if (own_support) release_support(w_, i);
+      after_velocity_change(i);
+    }
+    if (w_.radius[i] == 0.0 && face) {
+      // A point sits on the line at impact: keep it a hair on its own side, so that
+      // the next face test knows which side it is on.
+      const double D = dot(w_.pos[i] - seg.from, n);
+      const double delta = 64.0 * 2.220446049250313e-16 * w_.length_scale;
+      if (D < delta) w_.pos[i] += (delta - D) * n;
+    }
+    if (r.event) record_contact(w_, i, kNone, &seg, t_abs, ctx_.dt);
+    ++w_.version[i];
+    destroy_after(i, r.destroy_first);
+    reschedule(i, t, kNone);
+  }
+
+  void finish_with_lecture_pass(double t) {
+    w_.stats.event_cap_hit = true;
+    if (w_.cap_hits == 0) w_.first_cap_time = ctx_.t0 + t;
+    ++w_.cap_hits;
+    w_.heap.clear();
+    for (std::uint32_t i = 0; i < w_.size(); ++i) {
+      if (w_.dynamic(i)) w_.advance(i, t);
+    }
+    collide_lecture(w_, ctx_, t);
+  }
+
+  World& w_;
+  StepContext& ctx_;
+  const double T_;
+};
+
+}  // namespace
+
+void collide_exact(World& w, StepContext& ctx) {
+  EventLoop loop(w, ctx);
+  loop.run();
+  w.stats.events = ctx.events;
+  w.max_events_seen = std::max(w.max_events_seen, ctx.events);
+}
+
+}  // namespace physval::core_detail

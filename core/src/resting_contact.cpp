@@ -1,0 +1,125 @@
+// Resting contact and friction (the lecture's section 5).
+//
+// A body pressed into a face (wall, box side, surface piece) that arrives too slowly
+// to bounce clear settles onto it: it keeps no normal velocity, the normal component
+// of its acceleration is taken by the support (N = -m a.n, so on an incline
+// N = m g cos(theta)), and along the face it feels Coulomb friction:
+//   - at rest, it stays at rest while |a_t| <= mu_s N / m (static friction);
+//   - sliding, it is decelerated by mu_k N / m (kinetic friction) until it stops;
+//     the stop is an event at the exact time, so friction never reverses a velocity;
+//   - a pair with rolling_friction c > 0 is a wheel: it rolls instead of sliding, held
+//     and slowed by c N (rolling resistance, c << mu) instead of mu_s and mu_k.
+// Bodies do not spin (lecture step 6), so a circle on an incline slides; a
+// "block on an incline" is a circle on an inclined wall.
+// The support holds while the force presses the body into the face and its contact
+// point stays on the segment; leaving either way releases it.
+#include <algorithm>
+#include <cmath>
+
+#include "physval/core/time_of_impact.hpp"
+#include "world.hpp"
+
+namespace physval::core_detail {
+
+namespace {
+
+struct Coefficients {
+  double moving;   // kinetic friction or rolling resistance
+  double holding;  // static friction or rolling resistance
+};
+
+Coefficients coefficients(const World& w, std::uint32_t i, const Segment& s) {
+  const PairMaterial m = w.pair_material(w.material[i], s.material);
+  if (m.rolling_friction > 0.0) return {m.rolling_friction, m.rolling_friction};
+  return {m.friction, std::max(m.static_friction, m.friction)};
+}
+
+}  // namespace
+
+void support_path(World& w, std::uint32_t i) {
+  const Segment& s = w.statics.segments[w.support[i]];
+  const Vec2 n = w.support_n[i];
+  const Vec2 t = perp(n);
+  const Vec2 a = w.acc[i];
+  const double normal_per_mass = -dot(a, n);   // N / m
+  const double vt = dot(w.vel[i], t);
+  w.vel[i] = vt * t;   // no normal velocity on a support
+  const double at = dot(a, t);
+  const Coefficients c = coefficients(w, i, s);
+  const double limit_moving = c.moving * std::max(normal_per_mass, 0.0);
+  const double limit_holding = c.holding * std::max(normal_per_mass, 0.0);
+  double a_t;
+  if (vt == 0.0) {
+    a_t = std::fabs(at) <= limit_holding ? 0.0 : at - std::copysign(limit_moving, at);
+  } else {
+    a_t = at - std::copysign(limit_moving, vt);
+  }
+  w.apath[i] = a_t * t;
+}
+
+void release_support(World& w, std::uint32_t i) {
+  w.support[i] = kNone;
+  w.apath[i] = w.acc[i];   // free for the rest of the step
+}
+
+void apply_supports(World& w, const StepContext& ctx) {
+  const std::size_t n = w.size();
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (w.support[i] == kNone) continue;
+    if (!w.dynamic(i)) {
+      w.support[i] = kNone;
+      continue;
+    }
+    const Segment& s = w.statics.segments[w.support[i]];
+    const Vec2 nrm = w.support_n[i];
+    const double u = dot(w.pos[i] - s.from, s.dir);
+    const double gap = dot(w.pos[i] - s.from, nrm) - w.radius[i];
+    const double tol = 1e-9 * (w.radius[i] + w.length_scale);
+    const bool on_segment = u >= 0.0 && u <= s.length;
+    const bool pressed = dot(w.acc[i], nrm) < 0.0;
+    if (!on_segment || !pressed || std::fabs(gap) > tol) {
+      release_support(w, i);
+      continue;
+    }
+    support_path(w, i);
+    // Still touching at the end of this step: one continuing contact.
+    if (!w.last_touch.empty()) w.last_touch[i] = ctx.t0;
+  }
+}
+
+double support_stop_time(const World& w, std::uint32_t i, double t, double T) {
+  const Vec2 tang = perp(w.support_n[i]);
+  const double vt = dot(w.vel_at(i, t), tang);
+  const double at = dot(w.apath[i], tang);
+  if (vt == 0.0 || at == 0.0 || (vt > 0.0) == (at > 0.0)) return toi::kNever;
+  const double s = -vt / at;
+  return t + s <= T ? t + s : toi::kNever;
+}
+
+double support_leave_time(const World& w, std::uint32_t i, double t, double T) {
+  const Segment& s = w.statics.segments[w.support[i]];
+  const Vec2 p = w.pos_at(i, t);
+  const Vec2 v = w.vel_at(i, t);
+  const Vec2 a = w.apath[i];
+  // u(s) = u0 + u1 s + u2 s^2 along the segment; it leaves at u = 0 falling or at
+  // u = L rising.
+  const double u0 = dot(p - s.from, s.dir), u1 = dot(v, s.dir), u2 = 0.5 * dot(a, s.dir);
+  const toi::Tolerance tol = toi::linear_tolerance(w.length_scale, length(v) + length(a) * (T - t));
+  toi::Poly lo;
+  lo.c[0] = u0;
+  lo.c[1] = u1;
+  lo.c[2] = u2;
+  lo.degree = 2;
+  toi::Poly hi;
+  hi.c[0] = s.length - u0;
+  hi.c[1] = -u1;
+  hi.c[2] = -u2;
+  hi.degree = 2;
+  // Exactly at an end point: it leaves if moving (or accelerating) outwards, else stays.
+  const double a_lo = toi::earliest_entry(lo, T - t, {0.0, tol.slope});
+  const double a_hi = toi::earliest_entry(hi, T - t, {0.0, tol.slope});
+  const double s_leave = std::min(a_lo, a_hi);
+  return s_leave == toi::kNever ? toi::kNever : t + s_leave;
+}
+
+}  // namespace physval::core_detail

@@ -1,0 +1,286 @@
+// core's world: every body in structure-of-arrays form, the static geometry, the
+// tables built from the scene, and the scratch storage the step reuses. Private to
+// core/src; the step's stages are free functions over it, one file each.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <random>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "physval/core/broadphase.hpp"
+#include "physval/core/core_engine.hpp"
+#include "physval/core/scene.hpp"
+#include "physval/core/vec2.hpp"
+
+namespace physval::core_detail {
+
+enum class Integrator : std::uint8_t { ExplicitEuler, SemiImplicitEuler, VelocityVerlet, Rk4 };
+enum class CollisionMode : std::uint8_t { Exact, Lecture };
+const char* integrator_name(Integrator i);
+
+inline constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+
+enum BodyFlag : std::uint8_t {
+  kAlive = 1,
+  kStatic = 2,
+  kPoint = 4,
+  kParticle = 8,
+  kDestroyOnHit = 16,   // particles with destroy_on_collision
+  kNoGravity = 32,      // particles of an emitter with gravity = false
+};
+
+// A piece of static geometry: a wall, one side of a box, or one piece of a surface.
+struct Segment {
+  Vec2 from, to;
+  Vec2 dir;              // unit, from -> to
+  Vec2 normal;           // unit, perp(dir)
+  double length = 0.0;
+  Vec2 normal_from, normal_to;   // response normals at the ends (surfaces); zero: geometric
+  ObjectRef owner;
+  std::uint16_t material = 0;
+  std::uint16_t group = 0;
+};
+
+// Static geometry with a hashed uniform grid for "which segments can this box touch".
+class StaticGeometry {
+ public:
+  std::vector<Segment> segments;
+  void build(double typical_body_size);
+  // Appends the segments whose (radius-free) boxes overlap `box`, once each.
+  void query(const Aabb& box, std::vector<std::uint32_t>& out) const;
+  std::size_t memory_bytes() const;
+
+ private:
+  std::vector<Aabb> boxes_;
+  bool use_grid_ = false;
+  double cell_ = 1.0;
+  std::uint32_t mask_ = 0;
+  std::vector<std::uint32_t> start_;   // CSR over hash buckets
+  std::vector<std::uint32_t> items_;
+  mutable std::vector<std::uint32_t> stamp_;
+  mutable std::uint32_t stamp_value_ = 0;
+};
+
+struct ForceParams {
+  double drag_linear = 0.0;
+  double drag_quadratic = 0.0;
+  std::int32_t thrust = -1;   // index into World::thrusts
+};
+
+enum class EventKind : std::uint8_t {
+  Explode,    // a = body (the parent), b = emitter
+  Pair,       // a < b, bodies
+  Static,     // a = body, b = segment, feature = 0 face, 1 cap at from, 2 cap at to
+  Stop,       // a = body sliding on its support comes to rest (friction)
+  Leave,      // a = body's support point leaves the end of its segment
+  Expire,     // a = particle reaches its lifetime
+};
+
+struct Event {
+  double time = 0.0;   // within the step, s from its start
+  std::uint32_t a = 0, b = 0;
+  std::uint32_t va = 0, vb = 0;   // versions of a and b when computed
+  EventKind kind = EventKind::Pair;
+  std::uint8_t feature = 0;
+};
+
+struct EmitterState {
+  EmitterDef def;
+  std::uint32_t parent = kNone;
+  std::mt19937_64 rng;
+  double next_emit = 0.0;   // trail: absolute time of the next particle
+  bool exploded = false;
+  std::uint32_t serial = 0;
+  // An explosion recorded during the step, spawned at its end.
+  bool pending = false;
+  Vec2 at_position, at_velocity;
+  double at_time = 0.0;
+};
+
+struct StepContext {
+  double t0 = 0.0;     // simulated time at the start of the step
+  double dt = 0.0;
+  std::int64_t event_cap = 0;
+  std::int64_t events = 0;
+};
+
+struct World {
+  // ---- settings (EngineInfo options, after defaults)
+  Integrator integrator = Integrator::VelocityVerlet;
+  CollisionMode mode = CollisionMode::Exact;
+  BroadPhaseKind broadphase = BroadPhaseKind::Grid;
+  bool broadphase_auto = true;
+  double cell_size = 0.0;
+  std::int64_t max_events_option = 0;
+  double rest_speed_option = 0.0;
+
+  // ---- world-wide models
+  Vec2 gravity;
+  Vec2 wind;
+  bool newtonian = false;
+  double G = 0.0;
+  double softening = 0.0;
+  bool any_forces = false;       // acc / apath exist (something accelerates a body)
+  bool varying_forces = false;   // drag, thrust or Newtonian: a depends on the state
+  double time = 0.0;
+  double length_scale = 1.0;     // extent of the scene, for round-off tolerances
+  double rest_factor = 1.0 / 16.0;   // auto rest speed = rest_factor |a_n| dt
+
+  // ---- bodies (structure of arrays). Optional arrays are empty when unused.
+  std::size_t scene_bodies = 0;
+  std::vector<Vec2> pos, vel;
+  std::vector<double> tloc;          // time within the step up to which pos/vel hold
+  std::vector<double> inv_mass;      // 0 for static bodies
+  std::vector<double> radius;
+  std::vector<std::uint32_t> version;
+  std::vector<std::uint8_t> flags;
+  std::vector<std::uint16_t> group, material;
+  std::vector<double> mass;          // newtonian only (static bodies attract)
+  std::vector<double> angle;         // thrust only (heading)
+  std::vector<Vec2> acc;             // any_forces: force / mass at the step start
+  std::vector<Vec2> apath;           // any_forces: the path's acceleration this step
+  std::vector<Vec2> vcorr;           // varying_forces: end-of-step velocity correction
+  std::vector<ForceParams> fparams;  // drag or thrust only
+  std::vector<ThrustDef> thrusts;
+  std::vector<std::uint32_t> support;   // any_forces: segment a body rests on, or kNone
+  std::vector<Vec2> support_n;
+  std::vector<std::uint32_t> last_partner;   // any_forces: contact continuity
+  std::vector<double> last_touch;
+  std::vector<std::string> names;    // scene bodies only (particles are named on demand)
+
+  // ---- particles (index i - scene_bodies)
+  std::vector<EmitterState> emitters;
+  std::vector<double> birth, lifetime;
+  std::vector<std::uint32_t> parent;
+  std::vector<std::uint16_t> emitter_of;
+  std::vector<std::uint32_t> serial;
+
+  // ---- static geometry, materials, collision matrix
+  StaticGeometry statics;
+  std::uint16_t n_materials = 0;
+  Scene override_scene;   // only .materials: the per-pair overrides by name
+  struct MaterialRep {
+    std::string name;   // non-empty when an override names it
+    double restitution, friction, static_friction, rolling_friction;
+  };
+  std::vector<MaterialRep> materials;
+  std::vector<PairMaterial> material_table;   // n_materials^2 when small, else empty
+  std::uint16_t n_groups = 0;
+  std::vector<PairResponse> responses;        // n_groups^2
+  bool any_rules = false;
+
+  // ---- broad phase and scratch
+  std::unique_ptr<BroadPhase> bp;
+  std::vector<Aabb> boxes;
+  std::vector<std::uint8_t> active;
+  std::vector<BodyPair> pairs;
+  std::vector<std::uint32_t> found;
+  std::vector<std::uint32_t> found_static;
+  std::vector<Event> heap;
+  std::vector<std::uint64_t> passing;   // pass-through pairs now overlapping, sorted
+  std::vector<Vec2> scratch_p, scratch_v, scratch_a[4], scratch_f;   // rk4, verlet, lecture
+
+  // ---- output
+  std::vector<ContactEvent> contacts;
+  CoreStepStats stats;
+  std::int64_t cap_hits = 0;
+  double first_cap_time = -1.0;
+  std::int64_t max_events_seen = 0;
+
+  // ---- helpers
+  std::size_t size() const { return pos.size(); }
+  bool alive(std::uint32_t i) const { return (flags[i] & kAlive) != 0; }
+  bool is_static(std::uint32_t i) const { return (flags[i] & kStatic) != 0; }
+  bool dynamic(std::uint32_t i) const { return (flags[i] & (kAlive | kStatic)) == kAlive; }
+  bool supported(std::uint32_t i) const { return !support.empty() && support[i] != kNone; }
+  Vec2 path_acc(std::uint32_t i) const { return apath.empty() ? Vec2{} : apath[i]; }
+  Vec2 force_acc(std::uint32_t i) const { return acc.empty() ? Vec2{} : acc[i]; }
+  // The acceleration that presses contacts: the constrained one for a supported body.
+  Vec2 effective_acc(std::uint32_t i) const { return supported(i) ? apath[i] : force_acc(i); }
+  Vec2 pos_at(std::uint32_t i, double t) const {
+    const double s = t - tloc[i];
+    return pos[i] + s * vel[i] + (0.5 * s * s) * path_acc(i);
+  }
+  Vec2 vel_at(std::uint32_t i, double t) const { return vel[i] + (t - tloc[i]) * path_acc(i); }
+  void advance(std::uint32_t i, double t) {
+    const double s = t - tloc[i];
+    if (s == 0.0) return;
+    const Vec2 a = path_acc(i);
+    pos[i] += s * vel[i] + (0.5 * s * s) * a;
+    vel[i] += s * a;
+    tloc[i] = t;
+  }
+  const PairResponse& response(std::uint16_t g1, std::uint16_t g2) const {
+    return responses[static_cast<std::size_t>(g1) * n_groups + g2];
+  }
+  PairMaterial pair_material(std::uint16_t m1, std::uint16_t m2) const;
+  // The rest speed for a contact pressed together with normal acceleration a_n.
+  double rest_speed(double a_n, double dt) const {
+    return rest_speed_option > 0.0 ? rest_speed_option : rest_factor * std::abs(a_n) * dt;
+  }
+  std::size_t memory_bytes() const;
+};
+
+// ---- loading (world_load.cpp)
+void load_world(World& w, const Scene& scene);
+std::vector<OptionSpec> core_option_specs();
+
+// ---- stages of the step, in pipeline order
+void compute_accelerations(World& w, std::span<const Vec2> pos, std::span<const Vec2> vel,
+                           std::span<Vec2> out);                 // accelerations.cpp
+void apply_supports(World& w, const StepContext& ctx);          // resting_contact.cpp
+void begin_paths(World& w, const StepContext& ctx);             // integrators.cpp
+void collide_exact(World& w, StepContext& ctx);                 // exact_collisions.cpp
+void collide_lecture(World& w, StepContext& ctx, double t_from);   // lecture_collisions.cpp
+void end_paths(World& w, const StepContext& ctx);               // integrators.cpp
+void finish_particles(World& w, const StepContext& ctx);        // particles.cpp
+// Particles (particles.cpp): explosion events for the exact loop, and the one that
+// kills a parent at its explosion time.
+void schedule_explosions(World& w, const StepContext& ctx, std::vector<Event>& out);
+void explode_parent(World& w, std::uint32_t emitter, double t_abs);
+
+// ---- shared pieces
+// Path acceleration of a supported body: the normal component removed and Coulomb
+// friction (or rolling resistance) along the support (resting_contact.cpp).
+void support_path(World& w, std::uint32_t i);
+// Releases body i from its support.
+void release_support(World& w, std::uint32_t i);
+// Time within the step at which a supported body stops sliding or leaves its
+// segment, from time t (toi::kNever if not in [t, T]).
+double support_stop_time(const World& w, std::uint32_t i, double t, double T);
+double support_leave_time(const World& w, std::uint32_t i, double t, double T);
+
+// Box bounding body i's path from t to T (swept), plus its radius.
+Aabb path_box(const World& w, std::uint32_t i, double t, double T);
+
+// Impulse resolution (collision_response.cpp). n points from the first object to the
+// second. Returns the normal impulse magnitude.
+struct ImpactResult {
+  double normal_impulse = 0.0;
+  double closing_speed = 0.0;   // -(relative normal velocity) before, >= 0
+};
+ImpactResult resolve_pair(World& w, std::uint32_t i, std::uint32_t j, Vec2 n, const PairMaterial& m,
+                          double min_separation_speed);
+ImpactResult resolve_static(World& w, std::uint32_t i, Vec2 n, const PairMaterial& m,
+                            double min_separation_speed);
+// Records a contact event if the contact begins (see exact_collisions.cpp) at absolute
+// time t. partner: a body index, or static_partner_key(segment owner).
+void record_contact(World& w, std::uint32_t i, std::uint32_t partner_body, const Segment* seg,
+                    double t_abs, double window);
+std::uint32_t static_partner_key(const ObjectRef& owner);
+
+void kill_body(World& w, std::uint32_t i);
+
+// Pass-through pairs (collision matrix "event" and overlap tracking).
+std::uint64_t pair_key(std::uint32_t i, std::uint32_t j);
+std::uint64_t static_key(std::uint32_t i, std::uint32_t segment);
+bool is_passing(const World& w, std::uint64_t key);
+void add_passing(World& w, std::uint64_t key);
+void prune_passing(World& w);   // drops pairs that no longer overlap
+
+}  // namespace physval::core_detail
