@@ -1,0 +1,176 @@
+// The physval command as a user meets it: exit statuses, messages naming file, line
+// and key, results.json whole, gate failures, JUnit XML a parser accepts.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int status = -1;
+  std::string output;   // stdout and stderr
+};
+
+Result physval(const std::string& args) {
+  Result r;
+  const std::string cmd = std::string(PHYSVAL_EXE) + " " + args + " 2>&1";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (p == nullptr) return r;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  const int w = ::pclose(p);
+  r.status = WIFEXITED(w) ? WEXITSTATUS(w) : -1;
+  return r;
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("physval_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path write(const std::string& name, const std::string& text) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p;
+  }
+  fs::path dir_;
+};
+
+constexpr const char* kHeadOn = R"(name = "head_on"
+duration = 1.0
+dt = 0.001
+engines = ["core"]
+
+[[bodies]]
+name = "a"
+radius = 0.5
+mass = 1.0
+position = [-1.25, 0.0]
+velocity = [2.0, 0.0]
+
+[[bodies]]
+name = "b"
+radius = 0.5
+mass = 3.0
+position = [1.25, 0.0]
+velocity = [-1.0, 0.0]
+
+[expect]
+first_contact = { a = "a", b = "b", time = 0.5 }
+final = [ { body = "a", velocity = [-2.5, 0.0] }, { body = "b", velocity = [0.5, 0.0] } ]
+
+[gate]
+energy_drift = 1e-9
+linear_momentum_drift = 1e-12
+)";
+
+TEST_F(Cli, CheckAcceptsTheBuiltInSuite) {
+  const Result r = physval(std::string("check ") + PHYSVAL_SCENARIO_DIR);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("scenarios valid"), std::string::npos) << r.output;
+}
+
+TEST_F(Cli, CheckNamesFileLineAndKeyAndExitsTwo) {
+  const fs::path bad = write("bad.toml", "name = \"bad\"\nduration = 1.0\n[[bodies]]\nname = \"a\"\nradius = -1\nposition = [0, 0]\n");
+  const Result r = physval("check " + bad.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find(bad.string() + ":5:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("bodies[0].radius"), std::string::npos) << r.output;
+}
+
+TEST_F(Cli, RunWithBadInputRunsNothingAndWritesNothing) {
+  const fs::path bad = write("bad.toml", "name = \"bad\"\nduration = 0\n");
+  const Result r = physval("run " + bad.string() + " --out " + (dir_ / "out").string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "results.json"));
+}
+
+TEST_F(Cli, UsageErrorsExitTwo) {
+  EXPECT_EQ(physval("").status, 2);
+  EXPECT_EQ(physval("frobnicate").status, 2);
+  const fs::path good = write("good.toml", kHeadOn);
+  EXPECT_EQ(physval("run " + good.string() + " --dt banana").status, 2);
+  EXPECT_EQ(physval("run " + good.string() + " --engines nosuch").status, 2);
+  EXPECT_EQ(physval("run --help").status, 0);
+}
+
+TEST_F(Cli, EnginesListsEveryEngine) {
+  const Result r = physval("engines --json");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);
+  std::vector<std::string> names;
+  for (const auto& e : j) names.push_back(e["name"].get<std::string>());
+  EXPECT_EQ(names, (std::vector<std::string>{"core", "box2d", "bullet"}));
+}
+
+TEST_F(Cli, RunWritesResultsJsonWithTheContractKeys) {
+  const fs::path good = write("good.toml", kHeadOn);
+  const fs::path out = dir_ / "out";
+  const Result r = physval("run " + good.string() + " --out " + out.string());
+  EXPECT_EQ(r.status, 0) << r.output;
+  std::ifstream in(out / "results.json");
+  ASSERT_TRUE(in.good());
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_TRUE(j.contains("physval_version"));
+  for (const char* k : {"date", "host", "build_type", "engines"}) EXPECT_TRUE(j["context"].contains(k)) << k;
+  ASSERT_EQ(j["runs"].size(), 1u);
+  const auto& run = j["runs"][0];
+  for (const char* k : {"scenario", "engine", "engine_version", "dt", "steps", "status", "reason", "wall_seconds",
+                        "metrics", "contacts", "final", "checks"}) {
+    EXPECT_TRUE(run.contains(k)) << k;
+  }
+  for (const char* k : {"energy_drift", "linear_momentum_drift", "angular_momentum_drift", "energy_divergence",
+                        "linear_momentum_divergence", "position_divergence", "first_contact_time", "contact_time_error",
+                        "missed_contacts", "extra_contacts"}) {
+    EXPECT_TRUE(run["metrics"].contains(k)) << k;
+  }
+  EXPECT_EQ(run["status"], "ok");
+  EXPECT_EQ(run["steps"], 1000);
+  // The table fits in 100 columns.
+  std::istringstream lines(r.output);
+  for (std::string line; std::getline(lines, line);) EXPECT_LE(line.size(), 100u) << line;
+}
+
+TEST_F(Cli, GateFailsWhenALimitIsTightenedBelowWhatTheEngineAchieves) {
+  const fs::path good = write("good.toml", kHeadOn);
+  const fs::path junit = dir_ / "junit.xml";
+  Result r = physval("gate " + good.string() + " --out " + (dir_ / "o1").string() + " --junit " + junit.string());
+  EXPECT_EQ(r.status, 0) << r.output;
+  // Contact time is exact in core to round-off, but not to zero: a limit of 0 must fail.
+  std::string tight = kHeadOn;
+  tight += "contact_time_error = 0.0\nposition_divergence = 0.0\n";
+  const fs::path t = write("tight.toml", tight);
+  r = physval("gate " + t.string() + " --out " + (dir_ / "o2").string() + " --junit " + junit.string());
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_NE(r.output.find("FAILED"), std::string::npos) << r.output;
+  // A JUnit parser accepts the file: Python's ElementTree, counting cases and failures.
+  const std::string py = "python3 -c \"import xml.etree.ElementTree as E,sys; r=E.parse(sys.argv[1]).getroot(); "
+                         "s=r.find('testsuite'); c=s.findall('testcase'); "
+                         "print(len(c), len([x for x in c if x.find('failure') is not None]))\" " +
+                         junit.string();
+  FILE* p = ::popen(py.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  char buf[64] = {};
+  const std::size_t n = std::fread(buf, 1, sizeof buf - 1, p);
+  EXPECT_EQ(::pclose(p), 0);
+  EXPECT_EQ(std::string(buf, n), "1 1\n");
+}
+
+}  // namespace
