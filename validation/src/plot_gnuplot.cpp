@@ -94,10 +94,12 @@ struct Extent {
   bool empty() const { return !(lo <= hi); }
 };
 
-std::string axis_commands(char name, const Axis& axis, const Extent& data) {
+// `label_gap`: an empty line under the label, so a legend placed below the plot does
+// not cover it (gnuplot underestimates cairo's text height there).
+std::string axis_commands(char name, const Axis& axis, const Extent& data, bool label_gap = false) {
   std::ostringstream os;
   const std::string a(1, name);
-  os << "set " << a << "label " << gp_string(axis.label) << " noenhanced\n";
+  os << "set " << a << "label " << gp_string(axis.label + (label_gap ? "\n" : "")) << " noenhanced\n";
   if (axis.log) {
     os << "set logscale " << a << " 10\n";
     // Power-of-ten labels only when the axis spans a decade; otherwise plain numbers
@@ -195,11 +197,12 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
     if (!panel.note.empty()) title += "\n" + panel.note;
     os << "unset label\n";
     os << "set title " << gp_string(title) << " noenhanced font ',12'\n";
-    os << axis_commands('x', panel.x, ex) << axis_commands('y', panel.y, ey);
+    const bool key_below = panel.key.find("below") != std::string::npos;
+    os << axis_commands('x', panel.x, ex, key_below) << axis_commands('y', panel.y, ey);
     if (panel.key == "off") {
       os << "set key off\n";
     } else {
-      os << "set key " << panel.key << " box opaque samplen 3 spacing 1.15 font ',10' noenhanced\n";
+      os << "set key default\nset key " << panel.key << " box opaque samplen 3 spacing 1.15 font ',10' noenhanced\n";
     }
     os << (panel.equal_aspect ? "set size ratio -1\n" : "set size noratio\n");
     for (std::size_t i = 0; i < panel.labels.size(); ++i) {
@@ -233,6 +236,7 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
     if (parts.empty()) {
       // An empty panel still renders (and says so) rather than failing the figure.
       os << "unset logscale xy\nset format x \"%g\"\nset format y \"%g\"\n"
+         << "set xtics auto norotate\nset ytics auto norotate\nset mxtics default\nset mytics default\n"
          << "set xrange [0:1]\nset yrange [0:1]\nset key off\n"
          << "set label 1 \"no data to plot\" at graph 0.5, graph 0.5 center font ',14' noenhanced\n"
          << "plot 2 notitle\n";

@@ -263,9 +263,19 @@ plot::Figure momentum_figure(const ScenarioView& v, const std::vector<std::strin
 
 constexpr std::size_t kMaxTrajectoryBodies = 8;
 
+struct Extent {
+  double lo = INFINITY;
+  double hi = -INFINITY;
+  void add(double v) {
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  bool empty() const { return !(lo <= hi); }
+};
+
 plot::Figure trajectory_figure(const ScenarioView& v, const std::vector<std::string>& engines) {
   plot::Figure fig;
-  fig.height = 800;
+  fig.height = 760;
   plot::Panel p;
   p.x.label = "x (m)";
   p.y.label = "y (m)";
@@ -306,6 +316,33 @@ plot::Figure trajectory_figure(const ScenarioView& v, const std::vector<std::str
         }
       }
     }
+  }
+  // Equal scales on both axes, but the ranges widened to the canvas's shape so a
+  // fall (tall and thin) or a head-on collision (wide and flat) fills the picture.
+  Extent ex, ey;
+  for (const plot::Series& c : p.series) {
+    for (std::size_t k = 0; k < c.x.size() && k < c.y.size(); ++k) {
+      if (!std::isfinite(c.x[k]) || !std::isfinite(c.y[k])) continue;
+      ex.add(c.x[k]);
+      ey.add(c.y[k]);
+    }
+  }
+  if (!ex.empty()) {
+    constexpr double kPlotAspect = 1.15;   // width / height of the plot area, m per m
+    double xs = ex.hi - ex.lo, ys = ey.hi - ey.lo;
+    const double floor_span = std::max({xs, ys, 1e-3});
+    xs = std::max(xs, 0.05 * floor_span);
+    ys = std::max(ys, 0.05 * floor_span);
+    if (xs / ys < kPlotAspect) {
+      xs = ys * kPlotAspect;
+    } else {
+      ys = xs / kPlotAspect;
+    }
+    const double cx = 0.5 * (ex.lo + ex.hi), cy = 0.5 * (ey.lo + ey.hi);
+    p.x.min = cx - 0.55 * xs;
+    p.x.max = cx + 0.55 * xs;
+    p.y.min = cy - 0.55 * ys;
+    p.y.max = cy + 0.55 * ys;
   }
   fig.title = v.name + ": trajectories, engines overlaid on the reference";
   p.title = "each body's path; its name marks the start, a marker the end";
@@ -575,7 +612,7 @@ std::string settings_html(const ScenarioView& v) {
   for (const json* run : v.runs) {
     const json& settings = member(*run, "settings");
     const json& limits = member(*run, "limits_hit");
-    if (!settings.is_object() && !limits.is_array()) continue;
+    if (str(*run, "status") == "unsupported" || (!settings.is_object() && !limits.is_array())) continue;
     any = true;
     os << "<tr><td>" << html(str(*run, "engine")) << "</td><td class=num>";
     if (auto dt = num(*run, "dt")) os << fmt(*dt) << " s";
@@ -761,7 +798,16 @@ void write_report(const fs::path& dir, const Progress& progress) {
     page << "</tr>\n";
   }
   page << "</table>\n";
-  if (!views.empty()) {
+  const bool any_divergence = std::any_of(runs.begin(), runs.end(), [](const json& run) {
+    for (const char* m : {"position_divergence", "energy_divergence"}) {
+      if (auto v = num(member(run, "metrics"), m); v && *v > 0.0) return true;
+    }
+    return false;
+  });
+  if (!any_divergence) {
+    page << "<p class=note>No run has a measured divergence from a reference (none was available or converged), "
+            "so there is no overview plot.</p>\n";
+  } else {
     say("report: overview plot");
     page << figure_html(draw(overview_figure(views, ran), "overview", "divergence of every scenario and engine",
                              "Each engine's largest position divergence and its energy divergence from the scenario's "

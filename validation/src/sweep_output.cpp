@@ -20,6 +20,42 @@ std::string series_name(const std::string& engine, const std::string& setting) {
   return setting.empty() ? engine : engine + " " + setting;
 }
 
+// A setting as a legend shows it: "integrator=rk4 collision=exact" -> "rk4, exact";
+// "velocity_iterations=4 position_iterations=3" -> "4 velocity + 3 position iterations".
+std::string display_setting(const std::string& setting) {
+  std::istringstream in(setting);
+  std::string values, iterations;
+  for (std::string token; in >> token;) {
+    const auto eq = token.find('=');
+    if (eq == std::string::npos) {
+      values += (values.empty() ? "" : ", ") + token;
+      continue;
+    }
+    const std::string key = token.substr(0, eq), value = token.substr(eq + 1);
+    const std::string suffix = "_iterations";
+    if (key.size() > suffix.size() && key.compare(key.size() - suffix.size(), suffix.size(), suffix) == 0) {
+      iterations += (iterations.empty() ? "" : " + ") + value + " " + key.substr(0, key.size() - suffix.size());
+    } else {
+      values += (values.empty() ? "" : ", ") + value;
+    }
+  }
+  if (!iterations.empty()) values += (values.empty() ? "" : ", ") + iterations + " iterations";
+  return values;
+}
+
+std::string legend_name(const std::string& engine, const std::string& setting) {
+  const std::string shown = display_setting(setting);
+  return shown.empty() ? engine : engine + " " + shown;
+}
+
+// One legend column under the plot (the labels are long; a column keeps them whole).
+std::string legend_below(std::size_t entries) {
+  return "below center vertical maxrows " + std::to_string(std::max<std::size_t>(1, entries)) + " Left reverse";
+}
+
+// Room for the plot plus a legend row per entry.
+int figure_height(std::size_t entries) { return 560 + 18 * static_cast<int>(entries); }
+
 std::string sci(std::optional<double> v, const char* unit = "") {
   if (!v) return "-";
   char buf[40];
@@ -87,8 +123,13 @@ std::string order_text(const LogLogFit& f) {
   return buf;
 }
 
+// Below this, the errors do not follow a power of dt (contact timing, round-off):
+// the slope is reported but flagged.
+constexpr double kGoodFit = 0.9;
+
 plot::Figure speed_vs_error_figure(const SweepResult& r) {
   plot::Figure fig;
+  fig.height = figure_height(groups_of(r).size() + 1);
   fig.title = r.scenario + ": speed against accuracy";
   plot::Panel panel;
   panel.title = "each point one step size (coarse dt left, fine dt right); circled: the Pareto front";
@@ -96,11 +137,12 @@ plot::Figure speed_vs_error_figure(const SweepResult& r) {
   panel.y.label = "max position error against the reference (m, log scale)";
   panel.x.log = true;
   panel.y.log = true;
-  panel.key = "outside right top";
+  panel.key = legend_below(groups_of(r).size() + 1);
   const auto groups = groups_of(r);
   for (std::size_t g = 0; g < groups.size(); ++g) {
     plot::Series s;
-    s.title = groups[g].first;
+    const SweepPoint& first = r.points[groups[g].second.front()];
+    s.title = legend_name(first.engine, first.setting);
     s.color = static_cast<int>(g);
     s.dash = engine_dash(r, r.points[groups[g].second.front()].engine);
     for (std::size_t i : groups[g].second) {
@@ -134,6 +176,7 @@ plot::Figure speed_vs_error_figure(const SweepResult& r) {
 
 plot::Figure error_vs_dt_figure(const SweepResult& r) {
   plot::Figure fig;
+  fig.height = figure_height(groups_of(r).size());
   fig.title = r.scenario + ": error against step size";
   plot::Panel panel;
   panel.title = "legend: observed order of convergence (slope of log error against log dt)";
@@ -141,7 +184,7 @@ plot::Figure error_vs_dt_figure(const SweepResult& r) {
   panel.y.label = "max position error against the reference (m, log scale)";
   panel.x.log = true;
   panel.y.log = true;
-  panel.key = "outside right top";
+  panel.key = legend_below(groups_of(r).size());
   const auto groups = groups_of(r);
   for (std::size_t g = 0; g < groups.size(); ++g) {
     const SweepPoint& first = r.points[groups[g].second.front()];
@@ -149,7 +192,17 @@ plot::Figure error_vs_dt_figure(const SweepResult& r) {
     const auto order = std::find_if(r.orders.begin(), r.orders.end(), [&](const ConvergenceOrder& o) {
       return o.engine == first.engine && o.setting == first.setting;
     });
-    s.title = groups[g].first + "  (order " + (order != r.orders.end() ? order_text(order->position) : "n/a") + ")";
+    std::string order_note = "order n/a";
+    if (order != r.orders.end() && order->position.slope) {
+      char fit[64];
+      if (order->position.r_squared < kGoodFit) {
+        std::snprintf(fit, sizeof fit, "no clear order (R\u00b2 %.2f)", order->position.r_squared);
+      } else {
+        std::snprintf(fit, sizeof fit, "order %.2f", *order->position.slope);
+      }
+      order_note = fit;
+    }
+    s.title = legend_name(first.engine, first.setting) + ": " + order_note;
     s.color = static_cast<int>(g);
     s.dash = engine_dash(r, first.engine);
     for (std::size_t i : groups[g].second) {
@@ -315,7 +368,7 @@ void print_sweep_table(std::ostream& os, const SweepResult& r) {
       if (o.position.slope) {
         char buf[48];
         std::snprintf(buf, sizeof buf, " (%d points, R^2 %.3f)", o.position.points, o.position.r_squared);
-        os << buf;
+        os << buf << (o.position.r_squared < kGoodFit ? " no clear order" : "");
       }
       os << "  energy " << order_text(o.energy) << "\n";
     }
