@@ -298,6 +298,70 @@ TEST(SweepVariants, OneVariantWithoutSettings) {
   EXPECT_EQ(sweep_variants(plain, scene, true).size(), 1u);
 }
 
+// End to end on core: a two-body orbit with semi-implicit Euler, whose position
+// error is first order in dt. Checks the wiring (reference, common sample times,
+// comparison), not core's accuracy: the bounds on the order are loose.
+TEST(SweepRun, FirstOrderIntegratorOnAnOrbit) {
+  Scene scene;
+  scene.name = "sweep_orbit";
+  scene.duration = 3.0;
+  scene.dt = 0.01;
+  scene.world.newtonian = true;
+  scene.world.G = 1.0;
+  BodyDef a;
+  a.name = "a";
+  a.shape = ShapeKind::Point;
+  a.radius = 0.0;
+  a.mass = 1.0;
+  a.position = {1.0, 0.0};
+  a.velocity = {0.0, 0.5};
+  BodyDef b = a;
+  b.name = "b";
+  b.position = {-1.0, 0.0};
+  b.velocity = {0.0, -0.5};
+  scene.bodies = {a, b};
+  scene.engine_options["core"]["integrator"] = std::string("semi_implicit_euler");
+
+  SweepOptions options;
+  options.dts = {1.0 / 60, 1.0 / 30, 1.0 / 120};   // unsorted on purpose
+  options.engines = {"core"};
+  options.repetitions = 2;
+  options.settings = false;
+  options.min_seconds_per_repetition = 0.0;
+  std::vector<std::string> progress;
+  const SweepResult r = run_sweep(scene, options, [&](const std::string& line) { progress.push_back(line); });
+
+  ASSERT_TRUE(r.reference_available) << r.reference_reason;
+  ASSERT_EQ(r.points.size(), 3u);
+  EXPECT_GE(progress.size(), 3u);
+  double previous_dt = 1.0;
+  for (const SweepPoint& p : r.points) {
+    EXPECT_EQ(p.engine, "core");
+    EXPECT_EQ(p.status, RunStatus::Ok) << p.reason;
+    EXPECT_LT(p.dt, previous_dt);   // coarse to fine
+    previous_dt = p.dt;
+    EXPECT_EQ(p.repetitions, 2);
+    EXPECT_GT(p.wall_per_sim_median, 0.0);
+    EXPECT_LE(p.wall_per_sim_min, p.wall_per_sim_median);
+    EXPECT_GE(p.wall_per_sim_max, p.wall_per_sim_median);
+    ASSERT_TRUE(p.position_error.has_value());
+    EXPECT_GT(*p.position_error, 0.0);
+  }
+  ASSERT_EQ(r.orders.size(), 1u);
+  ASSERT_TRUE(r.orders[0].position.slope.has_value());
+  EXPECT_NEAR(*r.orders[0].position.slope, 1.0, 0.25);
+}
+
+TEST(SweepRun, RejectsBadStepSizes) {
+  Scene scene;
+  scene.name = "x";
+  SweepOptions options;
+  options.dts = {0.01, -0.02};
+  EXPECT_THROW(run_sweep(scene, options), std::invalid_argument);
+  options.dts = {};
+  EXPECT_THROW(run_sweep(scene, options), std::invalid_argument);
+}
+
 TEST(SweepLabels, StepSizes) {
   EXPECT_EQ(dt_label(1.0 / 60), "1/60");
   EXPECT_EQ(dt_label(1.0 / 960), "1/960");
