@@ -62,10 +62,48 @@ void release_support(World& w, std::uint32_t i) {
   w.apath[i] = w.acc[i];   // free for the rest of the step
 }
 
+namespace {
+
+// A body touching a face, pressed into it and not moving away, settles onto it at the
+// start of the step (so that even explicit Euler, which applies a force only at the
+// end of a step, never pulls a resting body into its support).
+void detect_support(World& w, std::uint32_t i, const StepContext& ctx) {
+  const double r = w.radius[i];
+  const Vec2 p = w.pos[i];
+  const double tol = 1e-9 * (r + w.length_scale);
+  w.found_static.clear();
+  w.statics.query(make_aabb(p.x - r - tol, p.y - r - tol, p.x + r + tol, p.y + r + tol), w.found_static);
+  for (std::uint32_t k : w.found_static) {
+    const Segment& s = w.statics.segments[k];
+    if (w.any_rules && !w.response(w.group[i], s.group).collide) continue;
+    const double u = dot(p - s.from, s.dir);
+    if (u < 0.0 || u > s.length) continue;
+    const double D = dot(p - s.from, s.normal);
+    const Vec2 n = D >= 0.0 ? s.normal : -s.normal;
+    if (std::fabs(std::fabs(D) - r) > tol) continue;
+    const double an = dot(w.acc[i], n);
+    if (!(an < 0.0)) continue;
+    const double vn = dot(w.vel[i], n);
+    if (vn > 0.0 || -vn > w.rest_speed(an, ctx.dt)) continue;
+    w.support[i] = k;
+    w.support_n[i] = n;
+    record_contact(w, i, kNone, &s, ctx.t0, ctx.dt);
+    return;
+  }
+}
+
+}  // namespace
+
 void apply_supports(World& w, const StepContext& ctx) {
   const std::size_t n = w.size();
   for (std::uint32_t i = 0; i < n; ++i) {
-    if (w.support[i] == kNone) continue;
+    if (w.support[i] == kNone) {
+      if (w.dynamic(i) && !w.statics.segments.empty()) {
+        detect_support(w, i, ctx);
+        if (w.support[i] != kNone) support_path(w, i);
+      }
+      continue;
+    }
     if (!w.dynamic(i)) {
       w.support[i] = kNone;
       continue;

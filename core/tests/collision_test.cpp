@@ -1,0 +1,140 @@
+// Impacts against closed forms: the lecture's head-on formula (with its typo caught),
+// equal masses, oblique impacts, extreme mass ratios, tunnelling, Newton's cradle.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "scene_fixture.hpp"
+
+namespace physval::test {
+
+TEST(CoreCollision, HeadOnElasticOneToThree) {
+  // m1 = 1 at v = +2, m2 = 3 at v = -1: v1' = -2.5, v2' = +0.5. The lecture's slide
+  // prints v2' with (m1 - m2), which would give +1.5 and break momentum conservation.
+  for (const char* mode : {"exact", "lecture"}) {
+    SCOPED_TRACE(mode);
+    Sim sim(scene_of({circle("a", {-2.0, 0.0}, {2.0, 0.0}, 0.5, 1.0), circle("b", {2.0, 0.0}, {-1.0, 0.0}, 0.5, 3.0)}),
+            options("velocity_verlet", mode));
+    sim.run_until(2.0, 1.0 / 60.0);
+    EXPECT_NEAR(sim.state("a").velocity.x, -2.5, 1e-12);
+    EXPECT_NEAR(sim.state("b").velocity.x, 0.5, 1e-12);
+    ASSERT_EQ(sim.contacts.size(), 1u);
+    // Gap 3 m closing at 3 m/s: t = 1. Exact mode finds it to round-off; the lecture's
+    // interpolation is exact here too (straight lines, head-on).
+    EXPECT_NEAR(sim.contacts[0].time, 1.0, 1e-12);
+    EXPECT_EQ(sim.contacts[0].a.index, 0u);
+    EXPECT_EQ(sim.contacts[0].b.index, 1u);
+    // And the positions continue from the impact point: a met b at x = 0, then -2.5 m/s.
+    EXPECT_NEAR(sim.state("a").position.x, 0.0 - 2.5 * 1.0, 1e-12);
+  }
+}
+
+TEST(CoreCollision, EqualMassesSwapVelocities) {
+  Sim sim(scene_of({circle("a", {-2.0, 0.0}, {3.0, 0.0}), circle("b", {2.0, 0.0}, {-1.0, 0.0})}));
+  sim.run_until(2.0, 0.01);
+  EXPECT_NEAR(sim.state("a").velocity.x, -1.0, 1e-12);
+  EXPECT_NEAR(sim.state("b").velocity.x, 3.0, 1e-12);
+}
+
+TEST(CoreCollision, ObliqueKeepsTangentialVelocity) {
+  // a moves along x with its centre 0.5 above b's (R = 1): at contact the normal is
+  // (sqrt(0.75), -0.5). Only the normal component changes; equal masses exchange it.
+  const Vec2 v{2.0, 0.0};
+  Sim sim(scene_of({circle("a", {-3.0, 0.5}, v), circle("b", {0.0, 0.0})}));
+  sim.run_until(2.0, 0.01);
+  const Vec2 n{std::sqrt(0.75), -0.5};
+  const Vec2 t = perp(n);
+  const BodyState a = sim.state("a"), b = sim.state("b");
+  EXPECT_NEAR(dot(a.velocity, t), dot(v, t), 1e-12);
+  EXPECT_NEAR(dot(a.velocity, n), 0.0, 1e-12);
+  EXPECT_NEAR(b.velocity.x, dot(v, n) * n.x, 1e-12);
+  EXPECT_NEAR(b.velocity.y, dot(v, n) * n.y, 1e-12);
+  // Energy is conserved (e = 1).
+  EXPECT_NEAR(length_squared(a.velocity) + length_squared(b.velocity), length_squared(v), 1e-12);
+}
+
+TEST(CoreCollision, MassRatioMillionConservesMomentum) {
+  const double M = 1e6, m = 1.0;
+  Sim sim(scene_of({circle("heavy", {-2.0, 0.0}, {1.0, 0.0}, 0.5, M), circle("light", {2.0, 0.0}, {-1.0, 0.0}, 0.5, m)}));
+  const double p0 = M * 1.0 + m * -1.0;
+  sim.run_until(3.0, 0.01);
+  const double vh = sim.state("heavy").velocity.x, vl = sim.state("light").velocity.x;
+  // Round-off: each velocity carries a relative error of a few ulps; momentum is the
+  // sum of two terms of size 1e6, so a few ulps of 1e6.
+  EXPECT_NEAR(M * vh + m * vl, p0, 8.0 * 2.2e-16 * M);
+  EXPECT_NEAR(vh, (2.0 * m * -1.0 + 1.0 * (M - m)) / (M + m), 1e-15 * 4.0);
+  EXPECT_NEAR(vl, (2.0 * M * 1.0 + -1.0 * (m - M)) / (M + m), 1e-15 * 8.0);
+}
+
+TEST(CoreCollision, StaticBodyReflects) {
+  Sim sim(scene_of({circle("ball", {-3.0, 0.0}, {2.0, 1.0}), static_circle("post", {0.0, 0.0}, 0.5)}));
+  sim.run_until(1.25, 0.01);   // head-on component: the centres at y = 0.5t...
+  sim.run_until(4.0, 0.01);
+  const BodyState b = sim.state("ball");
+  EXPECT_NEAR(length(b.velocity), std::sqrt(5.0), 1e-12);   // infinite mass: speed kept
+  EXPECT_EQ(sim.state("post").velocity.x, 0.0);
+  EXPECT_EQ(sim.state("post").position.x, 0.0);
+}
+
+TEST(CoreCollision, NoTunnellingAt1e4MetresPerSecond) {
+  // 166 m per step against a zero-thickness wall: exact mode reflects at t = 0.009995.
+  const double v = 1e4, r = 0.05;
+  Sim sim(scene_of({circle("bullet", {-100.0, 0.0}, {v, 0.0}, r)}, {wall("plate", {0.0, -1.0}, {0.0, 1.0})}));
+  sim.steps(3, 1.0 / 60.0);
+  ASSERT_EQ(sim.contacts.size(), 1u);
+  const double t_hit = (100.0 - r) / v;
+  EXPECT_NEAR(sim.contacts[0].time, t_hit, 1e-15 * 100.0);
+  EXPECT_NEAR(sim.state("bullet").position.x, -r - v * (3.0 / 60.0 - t_hit), 1e-9);
+  EXPECT_EQ(sim.state("bullet").velocity.x, -v);
+}
+
+TEST(CoreCollision, LectureModeTunnelsWhereExactDoesNot) {
+  // A small fast ball and a post: in one step the ball jumps from one side of the post
+  // to the other, so the end-of-step overlap test never sees it.
+  Scene s = scene_of({circle("bullet", {-2.0, 0.0}, {240.0, 0.0}, 0.05), static_circle("post", {0.0, 0.0}, 0.5)});
+  Sim lecture(s, options("velocity_verlet", "lecture"));
+  Sim exact(s, options("velocity_verlet", "exact"));
+  lecture.steps(2, 1.0 / 60.0);
+  exact.steps(2, 1.0 / 60.0);
+  EXPECT_GT(lecture.state("bullet").position.x, 0.0);   // passed through
+  EXPECT_TRUE(lecture.contacts.empty());
+  EXPECT_LT(exact.state("bullet").position.x, 0.0);     // bounced back
+  ASSERT_EQ(exact.contacts.size(), 1u);
+  EXPECT_NEAR(exact.contacts[0].time, (2.0 - 0.55) / 240.0, 1e-15);
+}
+
+TEST(CoreCollision, NewtonsCradlePassesMomentumThrough) {
+  // Ball 0 at 1 m/s meets four touching balls at t = 1: four impacts at the same
+  // instant, resolved in turn; the last ball leaves at 1 m/s, the others stop.
+  std::vector<BodyDef> balls = {circle("b0", {-2.0, 0.0}, {1.0, 0.0})};
+  for (int k = 1; k <= 4; ++k) balls.push_back(circle("b" + std::to_string(k), {static_cast<double>(k - 1), 0.0}));
+  Sim sim(scene_of(balls));
+  sim.run_until(2.0, 1.0 / 60.0);
+  for (int k = 0; k < 4; ++k) EXPECT_NEAR(sim.state(static_cast<std::size_t>(k)).velocity.x, 0.0, 1e-12) << k;
+  EXPECT_NEAR(sim.state(4).velocity.x, 1.0, 1e-12);
+  EXPECT_NEAR(sim.state(4).position.x, 3.0 + 1.0, 1e-12);
+  ASSERT_EQ(sim.contacts.size(), 4u);
+  for (const ContactEvent& c : sim.contacts) EXPECT_NEAR(c.time, 1.0, 1e-12);
+  EXPECT_TRUE(sim.engine.limits_hit().empty());
+}
+
+TEST(CoreCollision, EventCapFinishesWithLecturePass) {
+  // Cap at 2 events: the cradle needs 4 at one instant. The step finishes with the
+  // lecture pass instead of stalling, and the run says so.
+  std::vector<BodyDef> balls = {circle("b0", {-2.0, 0.0}, {1.0, 0.0})};
+  for (int k = 1; k <= 4; ++k) balls.push_back(circle("b" + std::to_string(k), {static_cast<double>(k - 1), 0.0}));
+  EngineOptions opt = options("velocity_verlet");
+  opt["max_events_per_step"] = std::int64_t{2};
+  Sim sim(scene_of(balls), opt);
+  sim.run_until(3.0, 1.0 / 60.0);
+  EXPECT_FALSE(sim.engine.limits_hit().empty());
+  double ke = 0.0, p = 0.0;
+  for (std::size_t k = 0; k < 5; ++k) {
+    ke += 0.5 * length_squared(sim.state(k).velocity);
+    p += sim.state(k).velocity.x;
+  }
+  EXPECT_LE(ke, 0.5 + 1e-12);    // no energy gained
+  EXPECT_NEAR(p, 1.0, 1e-12);    // momentum kept
+}
+
+}  // namespace physval::test

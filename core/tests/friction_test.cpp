@@ -1,0 +1,118 @@
+// Coulomb friction on walls and inclines: static friction holds, kinetic friction
+// decelerates at mu_k N / m and never reverses a velocity, rolling resistance is the
+// smaller coefficient of a wheel. Constant accelerations, so the closed forms hold to
+// round-off (1e-9).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "scene_fixture.hpp"
+
+namespace physval::test {
+
+namespace {
+constexpr double g = 9.8;
+
+// A circle resting halfway up an incline of angle theta (a wall rising to the right).
+Scene incline(double theta, double mu_k, double mu_s) {
+  const Vec2 dir{std::cos(theta), std::sin(theta)};
+  const Vec2 n = perp(dir);
+  const Vec2 contact = 5.0 * dir;
+  BodyDef block = circle("block", contact + 0.5 * n);
+  block.friction = mu_k;
+  block.static_friction = mu_s;
+  return scene_of({block}, {wall("incline", {0.0, 0.0}, 10.0 * dir, 1.0, mu_k, mu_s)}, {0.0, -g});
+}
+}  // namespace
+
+TEST(CoreFriction, BlockOnInclineHoldsBelowStaticLimit) {
+  // tan(20 deg) = 0.364 < mu_s = 0.5: no motion at all.
+  const double theta = 20.0 * std::numbers::pi / 180.0;
+  Scene s = incline(theta, 0.3, 0.5);
+  const Vec2 start = s.bodies[0].position;
+  for (const char* integ : {"semi_implicit_euler", "velocity_verlet", "rk4"}) {
+    SCOPED_TRACE(integ);
+    Sim sim(s, options(integ));
+    sim.run_until(3.0, 1.0 / 60.0);
+    EXPECT_NEAR(sim.state("block").position.x, start.x, 1e-12);
+    EXPECT_NEAR(sim.state("block").position.y, start.y, 1e-12);
+    EXPECT_EQ(length(sim.state("block").velocity), 0.0);
+  }
+}
+
+TEST(CoreFriction, BlockOnInclineSlidesAtKineticRate) {
+  // tan(20 deg) > mu_s = 0.3: slides with a = g (sin - mu_k cos), mu_k = 0.2.
+  const double theta = 20.0 * std::numbers::pi / 180.0;
+  const double mu_k = 0.2;
+  Scene s = incline(theta, mu_k, 0.3);
+  const Vec2 start = s.bodies[0].position;
+  const Vec2 down{-std::cos(theta), -std::sin(theta)};
+  Sim sim(s);
+  const double t = 1.5;
+  sim.run_until(t, 1.0 / 60.0);
+  const double a = g * (std::sin(theta) - mu_k * std::cos(theta));
+  const BodyState st = sim.state("block");
+  EXPECT_NEAR(dot(st.position - start, down), 0.5 * a * t * t, 1e-9);
+  EXPECT_NEAR(dot(st.velocity, down), a * t, 1e-9);
+  EXPECT_NEAR(cross(down, st.position - start), 0.0, 1e-9);   // stays on the incline
+}
+
+TEST(CoreFriction, SlidingStopsAndNeverReverses) {
+  // v0 = 3 m/s on a flat floor with mu_k = 0.3: stops at t = v0 / (mu g) after
+  // v0^2 / (2 mu g), and stays there.
+  const double mu = 0.3, v0 = 3.0;
+  BodyDef b = circle("puck", {0.0, 0.5}, {v0, 0.0});
+  b.friction = mu;
+  b.static_friction = mu;
+  Sim sim(scene_of({b}, {wall("floor", {-10.0, 0.0}, {10.0, 0.0}, 1.0, mu)}, {0.0, -g}));
+  const double t_stop = v0 / (mu * g), d_stop = v0 * v0 / (2.0 * mu * g);
+  sim.run_until(0.5 * t_stop, 1.0 / 60.0);
+  EXPECT_NEAR(sim.state("puck").velocity.x, v0 - mu * g * 0.5 * t_stop, 1e-9);
+  double min_v = v0;
+  while (sim.engine.time() < 3.0) {
+    sim.step(1.0 / 60.0);
+    min_v = std::min(min_v, sim.state("puck").velocity.x);
+  }
+  EXPECT_EQ(min_v, 0.0);   // reaches exactly zero, never negative
+  EXPECT_NEAR(sim.state("puck").position.x, d_stop, 1e-9);
+  EXPECT_EQ(sim.state("puck").velocity.x, 0.0);
+}
+
+TEST(CoreFriction, RollingResistanceIsTheSmallerBrake) {
+  // A wheel (rolling_friction c = 0.02) rolls v0^2 / (2 c g); the same body sliding
+  // with mu_k = 0.3 stops after v0^2 / (2 mu g).
+  const double v0 = 2.0, c = 0.02, mu = 0.3;
+  auto distance = [&](double rolling) {
+    BodyDef b = circle("wheel", {0.0, 0.5}, {v0, 0.0});
+    b.friction = mu;
+    b.static_friction = mu;
+    b.rolling_friction = rolling;
+    WallDef f = wall("floor", {-1.0, 0.0}, {100.0, 0.0}, 1.0, mu);
+    f.material.rolling_friction = rolling;
+    Sim sim(scene_of({b}, {f}, {0.0, -g}));
+    sim.run_until(15.0, 1.0 / 60.0);
+    EXPECT_EQ(sim.state("wheel").velocity.x, 0.0);
+    return sim.state("wheel").position.x;
+  };
+  EXPECT_NEAR(distance(c), v0 * v0 / (2.0 * c * g), 1e-9);
+  EXPECT_NEAR(distance(0.0), v0 * v0 / (2.0 * mu * g), 1e-9);
+}
+
+TEST(CoreFriction, ImpactFrictionNeverReversesTangentialVelocity) {
+  // A ball hitting a rough floor obliquely: the Coulomb impulse reduces the
+  // tangential speed by mu (1 + e) |vn| at most, and never below zero.
+  for (double mu : {0.1, 5.0}) {
+    SCOPED_TRACE(mu);
+    BodyDef b = circle("ball", {0.0, 1.5}, {1.0, -3.0});
+    b.friction = mu;
+    b.static_friction = mu;
+    Sim sim(scene_of({b}, {wall("floor", {-10.0, 0.0}, {10.0, 0.0}, 1.0, mu)}));
+    sim.run_until(0.5, 0.01);
+    const BodyState st = sim.state("ball");
+    EXPECT_NEAR(st.velocity.y, 3.0, 1e-12);
+    EXPECT_NEAR(st.velocity.x, std::max(0.0, 1.0 - mu * 2.0 * 3.0), 1e-12);
+  }
+}
+
+}  // namespace physval::test

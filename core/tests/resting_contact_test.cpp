@@ -1,0 +1,85 @@
+// Bouncing and resting against the floor under gravity: exact bounce times, energy
+// never gained, a ball at rest stays at rest with a bounded number of events.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "scene_fixture.hpp"
+
+namespace physval::test {
+
+namespace {
+constexpr double g = 9.8;
+Scene ball_over_floor(double bottom_height, double e, Vec2 v = {}) {
+  return scene_of({circle("ball", {0.0, bottom_height + 0.5}, v, 0.5, 1.0, e)},
+                  {wall("floor", {-50.0, 0.0}, {50.0, 0.0}, e)}, {0.0, -g});
+}
+double energy(const BodyState& s) { return 0.5 * length_squared(s.velocity) + g * (s.position.y - 0.5); }
+}  // namespace
+
+TEST(CoreResting, BallAtRestStaysAtRest) {
+  for (const char* integ : {"explicit_euler", "semi_implicit_euler", "velocity_verlet", "rk4"}) {
+    for (double e : {1.0, 0.5, 0.0}) {
+      SCOPED_TRACE(std::string(integ) + " e=" + std::to_string(e));
+      Sim sim(ball_over_floor(0.0, e), options(integ));
+      std::int64_t worst_events = 0;
+      for (int k = 0; k < 600; ++k) {
+        sim.step(1.0 / 60.0);
+        worst_events = std::max(worst_events, sim.engine.last_step_stats().events);
+        ASSERT_LE(energy(sim.state("ball")), 1e-9) << "step " << k;
+      }
+      EXPECT_NEAR(sim.state("ball").position.y, 0.5, 1e-9);
+      EXPECT_NEAR(sim.state("ball").velocity.y, 0.0, 1e-9);
+      EXPECT_LE(worst_events, 4);
+      EXPECT_LE(sim.contacts.size(), 1u);   // one contact, not one per step
+      EXPECT_TRUE(sim.engine.limits_hit().empty());
+    }
+  }
+}
+
+TEST(CoreResting, ElasticBounceKeepsItsHeight) {
+  // e = 1, dropped from 2 m: every bounce returns to 2 m; Verlet's parabola is exact,
+  // so the energy is conserved to round-off, bounce after bounce.
+  Sim sim(ball_over_floor(2.0, 1.0));
+  const double period = 2.0 * std::sqrt(2.0 * 2.0 / g);
+  double top = 0.0;
+  for (int k = 0; k < 1200; ++k) {
+    sim.step(1.0 / 60.0);
+    ASSERT_NEAR(energy(sim.state("ball")), 2.0 * g, 1e-9);
+    if (sim.engine.time() > 15.0) top = std::max(top, sim.state("ball").position.y - 0.5);
+  }
+  EXPECT_NEAR(top, 2.0, 0.01);   // sampled at steps: within 1/60 s of the apex
+  ASSERT_GE(sim.contacts.size(), 10u);
+  for (std::size_t k = 0; k < sim.contacts.size(); ++k) {
+    EXPECT_NEAR(sim.contacts[k].time, period * (static_cast<double>(k) + 0.5), 1e-9) << k;
+  }
+}
+
+TEST(CoreResting, InelasticBouncesThenSettles) {
+  // e = 0.5 from h = 1: impacts at t1 = sqrt(2h/g), then each flight 2 e^k v1 / g; the
+  // series sums to t1 (1 + 2e / (1 - e)) = 3 t1, after which the ball rests.
+  const double e = 0.5, h = 1.0, t1 = std::sqrt(2.0 * h / g), v1 = g * t1;
+  Sim sim(ball_over_floor(h, e));
+  sim.run_until(5.0, 1.0 / 60.0);
+  ASSERT_GE(sim.contacts.size(), 3u);
+  double t = t1;
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(sim.contacts[static_cast<std::size_t>(k)].time, t, 1e-9) << k;
+    t += 2.0 * std::pow(e, k + 1) * v1 / g;
+  }
+  EXPECT_NEAR(sim.state("ball").position.y, 0.5, 1e-9);
+  EXPECT_EQ(sim.state("ball").velocity.y, 0.0);
+  for (const ContactEvent& c : sim.contacts) EXPECT_LT(c.time, 3.0 * t1 + 1e-9);
+  EXPECT_TRUE(sim.engine.limits_hit().empty());
+}
+
+TEST(CoreResting, RollsOffTheEndAndFalls) {
+  // A ball sliding on a frictionless ledge leaves it and falls; it does not hang on.
+  Scene s = scene_of({circle("ball", {0.0, 5.5}, {2.0, 0.0})}, {wall("ledge", {-1.0, 5.0}, {1.0, 5.0})}, {0.0, -g});
+  Sim sim(s);
+  sim.run_until(2.0, 1.0 / 60.0);
+  EXPECT_LT(sim.state("ball").position.y, 0.0);
+  EXPECT_NEAR(sim.state("ball").velocity.x, 2.0, 1e-12);
+}
+
+}  // namespace physval::test
