@@ -1,0 +1,441 @@
+// The report's figures: how each quantity of a results folder is drawn. Every
+// engine keeps one colour, dash and marker across all plots; the reference is drawn
+// underneath as a thick grey line.
+#include "report_figures.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <set>
+
+namespace physval::report_detail {
+
+namespace fs = std::filesystem;
+
+std::string str(const json& j, const char* key, const std::string& fallback) {
+  if (!j.is_object()) return fallback;
+  auto it = j.find(key);
+  return it != j.end() && it->is_string() ? it->get<std::string>() : fallback;
+}
+
+std::optional<double> num(const json& j, const char* key) {
+  if (!j.is_object()) return std::nullopt;
+  auto it = j.find(key);
+  if (it == j.end() || !it->is_number()) return std::nullopt;
+  return it->get<double>();
+}
+
+const json& member(const json& j, const char* key) {
+  static const json null_value;
+  if (!j.is_object()) return null_value;
+  auto it = j.find(key);
+  return it != j.end() ? *it : null_value;
+}
+
+std::string fmt(double v, const char* spec) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, spec, v);
+  return buf;
+}
+
+namespace {
+
+std::vector<std::string> split_csv_line(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cell;
+  for (char c : line) {
+    if (c == ',') {
+      out.push_back(cell);
+      cell.clear();
+    } else if (c != '\r') {
+      cell += c;
+    }
+  }
+  out.push_back(cell);
+  return out;
+}
+
+}  // namespace
+
+std::optional<Table> read_table(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) return std::nullopt;
+  std::string line;
+  if (!std::getline(in, line)) return std::nullopt;
+  Table t;
+  t.names = split_csv_line(line);
+  t.columns.resize(t.names.size());
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    const std::vector<std::string> cells = split_csv_line(line);
+    for (std::size_t i = 0; i < t.names.size(); ++i) {
+      double v = NAN;
+      if (i < cells.size() && !cells[i].empty()) {
+        char* end = nullptr;
+        v = std::strtod(cells[i].c_str(), &end);
+        if (end == cells[i].c_str()) v = NAN;
+      }
+      t.columns[i].push_back(v);
+    }
+  }
+  return t;
+}
+
+namespace {
+
+constexpr const char* kReferenceColour = "#a8a8a8";
+
+// Colour and dash of an engine: by its place among all engines of the results, so an
+// engine looks the same in every plot of the report.
+struct Look {
+  int colour = 0;
+  int dash = 1;
+};
+Look look_of(const std::vector<std::string>& engines, const std::string& engine) {
+  static constexpr int kDashes[] = {1, 2, 4, 5, 3};
+  const auto it = std::find(engines.begin(), engines.end(), engine);
+  const std::size_t i = static_cast<std::size_t>(it - engines.begin());
+  return {static_cast<int>(i), kDashes[i % 5]};
+}
+
+plot::Series curve(const Source& s, const std::vector<std::string>& engines, const std::vector<double>& x,
+                   const std::vector<double>& y) {
+  plot::Series c;
+  c.x = x;
+  c.y = y;
+  if (s.engine.empty()) {
+    c.title = s.label;
+    c.rgb = kReferenceColour;
+    c.style = plot::Style::Lines;
+    c.line_width = 6.0;
+  } else {
+    const Look l = look_of(engines, s.engine);
+    c.title = s.label;
+    c.color = l.colour;
+    c.dash = l.dash;
+    c.style = plot::Style::LinesPoints;
+    c.line_width = 2.0;
+    c.point_type = std::vector<int>{7, 5, 9, 13, 11}[static_cast<std::size_t>(l.colour) % 5];
+    c.point_size = 1.1;
+    c.point_interval = std::max<int>(1, static_cast<int>(x.size() / 12));
+  }
+  return c;
+}
+
+}  // namespace
+
+std::string reference_label(const json* ref) {
+  std::string label = "reference";
+  if (ref != nullptr) {
+    if (auto dt = num(*ref, "dt"); dt && *dt > 0.0) label += " (core, dt " + fmt(*dt) + " s)";
+  }
+  return label;
+}
+
+plot::Figure energy_figure(const ScenarioView& v, const std::vector<std::string>& engines) {
+  plot::Figure fig;
+  fig.title = v.name + ": energy over time";
+  fig.height = 820;
+  plot::Panel total;
+  total.title = "total energy E = kinetic + potential";
+  total.x.label = "time (s)";
+  total.y.label = "energy (J)";
+  total.key = "outside right top";
+  plot::Panel error;
+  error.title = "energy error |E(t) - E(0)| of each run against its own start";
+  error.x.label = "time (s)";
+  error.y.label = "|E(t) - E(0)| (J, log scale)";
+  error.y.log = true;
+  error.key = "outside right top";
+  for (const Source& s : v.sources) {
+    const auto* t = s.table.column("t");
+    const auto* e = s.table.column("energy");
+    if (t == nullptr || e == nullptr || e->empty()) continue;
+    total.series.push_back(curve(s, engines, *t, *e));
+    std::vector<double> d(e->size());
+    for (std::size_t i = 0; i < e->size(); ++i) d[i] = std::abs((*e)[i] - e->front());
+    error.series.push_back(curve(s, engines, *t, d));
+  }
+  fig.panels = {total, error};
+  return fig;
+}
+
+plot::Figure momentum_figure(const ScenarioView& v, const std::vector<std::string>& engines) {
+  plot::Figure fig;
+  fig.title = v.name + ": momentum over time";
+  fig.height = 950;
+  struct Part {
+    const char* column;
+    const char* title;
+    const char* unit;
+  };
+  const Part parts[] = {{"px", "linear momentum, x component", "p_x (kg m/s)"},
+                        {"py", "linear momentum, y component", "p_y (kg m/s)"},
+                        {"angular_momentum", "angular momentum about the origin", "L (kg m^2/s)"}};
+  for (const Part& part : parts) {
+    plot::Panel p;
+    p.title = part.title;
+    p.x.label = "time (s)";
+    p.y.label = part.unit;
+    p.key = "outside right top";
+    for (const Source& s : v.sources) {
+      const auto* t = s.table.column("t");
+      const auto* y = s.table.column(part.column);
+      if (t != nullptr && y != nullptr) p.series.push_back(curve(s, engines, *t, *y));
+    }
+    fig.panels.push_back(std::move(p));
+  }
+  return fig;
+}
+
+namespace {
+
+constexpr std::size_t kMaxTrajectoryBodies = 8;
+
+struct Extent {
+  double lo = INFINITY;
+  double hi = -INFINITY;
+  void add(double v) {
+    lo = std::min(lo, v);
+    hi = std::max(hi, v);
+  }
+  bool empty() const { return !(lo <= hi); }
+};
+
+}  // namespace
+
+plot::Figure trajectory_figure(const ScenarioView& v, const std::vector<std::string>& engines) {
+  plot::Figure fig;
+  fig.height = 760;
+  plot::Panel p;
+  p.x.label = "x (m)";
+  p.y.label = "y (m)";
+  p.key = "outside right top";
+  p.equal_aspect = true;
+  std::set<std::string> labelled;
+  std::size_t body_total = 0;
+  for (const Source& s : v.sources) {
+    const std::vector<std::string> bodies = s.table.bodies();
+    body_total = std::max(body_total, bodies.size());
+    for (std::size_t b = 0; b < bodies.size() && b < kMaxTrajectoryBodies; ++b) {
+      const auto& x = *s.table.column("x_" + bodies[b]);
+      const auto& y = *s.table.column("y_" + bodies[b]);
+      plot::Series c = curve(s, engines, x, y);
+      if (b > 0) c.title.clear();   // one legend entry per engine
+      if (!s.engine.empty()) c.style = plot::Style::Lines;
+      p.series.push_back(c);
+      // Where the body ends, as a marker: divergence shows as markers apart.
+      for (std::size_t k = x.size(); k-- > 0;) {
+        if (std::isfinite(x[k]) && std::isfinite(y[k])) {
+          plot::Series end = c;
+          end.title.clear();
+          end.style = plot::Style::Points;
+          end.x = {x[k]};
+          end.y = {y[k]};
+          end.point_size = s.engine.empty() ? 2.4 : 1.5;
+          if (s.engine.empty()) end.point_type = 7;
+          p.series.push_back(std::move(end));
+          break;
+        }
+      }
+      if (labelled.insert(bodies[b]).second) {
+        for (std::size_t k = 0; k < x.size(); ++k) {
+          if (std::isfinite(x[k]) && std::isfinite(y[k])) {
+            p.labels.push_back({x[k], y[k], bodies[b]});
+            break;
+          }
+        }
+      }
+    }
+  }
+  // Equal scales on both axes, but the ranges widened to the canvas's shape so a
+  // fall (tall and thin) or a head-on collision (wide and flat) fills the picture.
+  Extent ex, ey;
+  for (const plot::Series& c : p.series) {
+    for (std::size_t k = 0; k < c.x.size() && k < c.y.size(); ++k) {
+      if (!std::isfinite(c.x[k]) || !std::isfinite(c.y[k])) continue;
+      ex.add(c.x[k]);
+      ey.add(c.y[k]);
+    }
+  }
+  if (!ex.empty()) {
+    constexpr double kPlotAspect = 1.15;   // width / height of the plot area, m per m
+    double xs = ex.hi - ex.lo, ys = ey.hi - ey.lo;
+    const double floor_span = std::max({xs, ys, 1e-3});
+    xs = std::max(xs, 0.05 * floor_span);
+    ys = std::max(ys, 0.05 * floor_span);
+    if (xs / ys < kPlotAspect) {
+      xs = ys * kPlotAspect;
+    } else {
+      ys = xs / kPlotAspect;
+    }
+    const double cx = 0.5 * (ex.lo + ex.hi), cy = 0.5 * (ey.lo + ey.hi);
+    p.x.min = cx - 0.55 * xs;
+    p.x.max = cx + 0.55 * xs;
+    p.y.min = cy - 0.55 * ys;
+    p.y.max = cy + 0.55 * ys;
+  }
+  fig.title = v.name + ": trajectories, engines overlaid on the reference";
+  p.title = "each body's path; its name marks the start, a marker the end";
+  if (body_total > kMaxTrajectoryBodies) {
+    p.title += " (first " + std::to_string(kMaxTrajectoryBodies) + " of " + std::to_string(body_total) + " bodies)";
+  }
+  fig.panels.push_back(std::move(p));
+  return fig;
+}
+
+namespace {
+
+struct ContactPoint {
+  std::string pair;
+  double time = 0.0;
+};
+
+std::vector<ContactPoint> contacts_of(const json& holder) {
+  std::vector<ContactPoint> out;
+  const json& list = member(holder, "contacts");
+  if (!list.is_array()) return out;
+  for (const json& c : list) {
+    const auto t = num(c, "time");
+    if (!t) continue;
+    std::string a = str(c, "a"), b = str(c, "b");
+    if (b < a) std::swap(a, b);
+    out.push_back({a + " / " + b, *t});
+  }
+  return out;
+}
+
+}  // namespace
+
+// Rows top to bottom: the reference, then each engine.
+std::optional<plot::Figure> contact_figure(const ScenarioView& v) {
+  struct Row {
+    std::string label;
+    std::vector<ContactPoint> contacts;
+  };
+  std::vector<Row> rows;
+  if (v.reference != nullptr && member(*v.reference, "contacts").is_array()) {
+    rows.push_back({"reference", contacts_of(*v.reference)});
+  }
+  for (const json* run : v.runs) {
+    if (str(*run, "status") != "ok") continue;
+    rows.push_back({str(*run, "engine"), contacts_of(*run)});
+  }
+  std::map<std::string, std::size_t> frequency;
+  std::size_t total = 0;
+  for (const Row& r : rows) {
+    for (const ContactPoint& c : r.contacts) ++frequency[c.pair];
+    total += r.contacts.size();
+  }
+  if (total == 0) return std::nullopt;
+
+  // The most frequent pairs get a colour each; the rest share one.
+  constexpr std::size_t kMaxPairs = 8;
+  std::vector<std::pair<std::size_t, std::string>> ranked;
+  for (const auto& [pair, n] : frequency) ranked.emplace_back(n, pair);
+  std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::map<std::string, std::size_t> pair_series;
+  for (std::size_t i = 0; i < ranked.size() && i < kMaxPairs; ++i) pair_series[ranked[i].second] = i;
+  const bool others = ranked.size() > kMaxPairs;
+
+  plot::Figure fig;
+  fig.title = v.name + ": contact timeline";
+  fig.height = std::clamp(260 + 70 * static_cast<int>(rows.size()), 420, 700);
+  plot::Panel p;
+  p.title = "a point where each engine reported a contact beginning; grey lines: the reference's contact times";
+  p.x.label = "time (s)";
+  p.y.label = "";
+  p.key = "outside right top";
+  const double n = static_cast<double>(rows.size());
+  p.y.min = -0.6;
+  p.y.max = n - 0.4;
+  if (v.duration > 0.0) {
+    p.x.min = 0.0;
+    p.x.max = v.duration;
+  }
+  for (std::size_t r = 0; r < rows.size(); ++r) p.y.tics.emplace_back(n - 1.0 - static_cast<double>(r), rows[r].label);
+
+  if (!rows.empty() && rows.front().label == "reference" && !rows.front().contacts.empty()) {
+    plot::Series guide;
+    guide.title = "reference contact times";
+    guide.rgb = "#c8c8c8";
+    guide.style = plot::Style::Lines;
+    guide.line_width = 1.0;
+    for (const ContactPoint& c : rows.front().contacts) {
+      guide.x.insert(guide.x.end(), {c.time, c.time, NAN});
+      guide.y.insert(guide.y.end(), {-0.5, n - 0.5, NAN});
+    }
+    p.series.push_back(std::move(guide));
+  }
+  std::vector<plot::Series> by_pair(std::min(ranked.size(), kMaxPairs) + (others ? 1 : 0));
+  for (std::size_t i = 0; i < by_pair.size(); ++i) {
+    by_pair[i].style = plot::Style::Points;
+    by_pair[i].point_size = 1.6;
+    by_pair[i].color = static_cast<int>(i);
+    by_pair[i].title = i < kMaxPairs && i < ranked.size() ? ranked[i].second : "other pairs";
+    if (i == kMaxPairs) by_pair[i].rgb = "#555555";
+  }
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    const double y = n - 1.0 - static_cast<double>(r);
+    for (const ContactPoint& c : rows[r].contacts) {
+      auto it = pair_series.find(c.pair);
+      plot::Series& s = by_pair[it != pair_series.end() ? it->second : kMaxPairs];
+      s.x.push_back(c.time);
+      s.y.push_back(y);
+    }
+  }
+  for (plot::Series& s : by_pair) p.series.push_back(std::move(s));
+  fig.panels.push_back(std::move(p));
+  return fig;
+}
+
+// Every scenario's position and energy divergence, one point per engine.
+plot::Figure overview_figure(const std::vector<ScenarioView>& views, const std::vector<std::string>& engines) {
+  plot::Figure fig;
+  fig.title = "all scenarios: how far each engine strays from the reference";
+  fig.height = 850;
+  struct Part {
+    const char* metric;
+    const char* title;
+    const char* unit;
+  };
+  const Part parts[] = {{"position_divergence", "max position divergence", "position divergence (m, log scale)"},
+                        {"energy_divergence", "energy divergence", "energy divergence (relative, log scale)"}};
+  for (const Part& part : parts) {
+    plot::Panel p;
+    p.title = part.title + std::string(" (missing point: not measured, or exactly zero)");
+    p.y.label = part.unit;
+    p.y.log = true;
+    p.key = "outside right top";
+    p.x.min = 0.5;
+    p.x.max = static_cast<double>(views.size()) + 0.5;
+    p.x.tic_rotation = views.size() > 4 ? 25 : 0;
+    for (std::size_t i = 0; i < views.size(); ++i) p.x.tics.emplace_back(static_cast<double>(i + 1), views[i].name);
+    for (const std::string& engine : engines) {
+      plot::Series s;
+      s.title = engine;
+      s.style = plot::Style::Points;
+      s.point_size = 1.8;
+      const Look l = look_of(engines, engine);
+      s.color = l.colour;
+      s.point_type = std::vector<int>{7, 5, 9, 13, 11}[static_cast<std::size_t>(l.colour) % 5];
+      for (std::size_t i = 0; i < views.size(); ++i) {
+        for (const json* run : views[i].runs) {
+          if (str(*run, "engine") != engine) continue;
+          if (auto m = num(member(*run, "metrics"), part.metric)) {
+            s.x.push_back(static_cast<double>(i + 1));
+            s.y.push_back(*m);
+          }
+        }
+      }
+      p.series.push_back(std::move(s));
+    }
+    fig.panels.push_back(std::move(p));
+  }
+  return fig;
+}
+
+}  // namespace physval::report_detail
