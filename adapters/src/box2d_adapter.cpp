@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -108,7 +109,10 @@ class Box2DEngine final : public Engine {
   std::unique_ptr<b2World> world_;
   std::vector<b2Body*> bodies_;          // scene order; nullptr once destroyed
   std::vector<BodyState> final_states_;  // the last state of each destroyed body
-  std::size_t dynamic_count_ = 0;
+  // How far a dynamic body may move in one step before Box2D's discrete collision
+  // between moving bodies can miss a contact: its radius plus the smallest other moving
+  // body's (infinite: no other moving body it could meet). Static shapes are swept.
+  std::vector<double> tunnel_size_;
   double time_ = 0.0;
   std::vector<ContactEvent> contacts_;
   LimitMonitor limits_;
@@ -166,7 +170,16 @@ void Box2DEngine::load(const Scene& scene) {
 void Box2DEngine::build_bodies() {
   bodies_.assign(scene_.bodies.size(), nullptr);
   final_states_.assign(scene_.bodies.size(), BodyState{});
-  dynamic_count_ = 0;
+  auto radius = [&](std::size_t i) {
+    return scene_.bodies[i].shape == ShapeKind::Point ? 0.0 : scene_.bodies[i].radius;
+  };
+  tunnel_size_.assign(scene_.bodies.size(), std::numeric_limits<double>::infinity());
+  for (std::size_t i = 0; i < scene_.bodies.size(); ++i) {
+    for (std::size_t j = 0; j < scene_.bodies.size(); ++j) {
+      const double size = radius(i) + radius(j);
+      if (j != i && !scene_.bodies[j].is_static && size > 0.0) tunnel_size_[i] = std::min(tunnel_size_[i], size);
+    }
+  }
   for (std::size_t i = 0; i < scene_.bodies.size(); ++i) {
     const BodyDef& b = scene_.bodies[i];
     b2BodyDef bd;
@@ -177,7 +190,6 @@ void Box2DEngine::build_bodies() {
       bd.linearVelocity = to_b2(b.velocity);
       // With fixed rotation the body keeps this spin unchanged: no contact alters it.
       bd.angularVelocity = static_cast<float>(b.angular_velocity);
-      ++dynamic_count_;
     }
     bd.allowSleep = false;
     bd.awake = true;
@@ -334,14 +346,13 @@ void Box2DEngine::check_limits(double dt) {
         return "body '" + name + "' spins at " + fmt(spin) + " rad/s, Box2D's cap of b2_maxRotation = pi/2 per step";
       });
     }
-    // Between two moving bodies Box2D's collision is discrete unless they are bullets:
-    // a body moving further than its radius in one step can pass through another.
-    if (!opt_.bullet && dynamic_count_ > 1 && scene_.bodies[i].shape == ShapeKind::Circle &&
-        static_cast<double>(speed) * dt > scene_.bodies[i].radius) {
+    // Between two moving bodies Box2D's collision is discrete unless they are bullets.
+    const double travel = static_cast<double>(speed) * dt;
+    if (!opt_.bullet && travel > tunnel_size_[i]) {
       limits_.hit("discrete_collision", time_, [&] {
-        return "body '" + name + "' moved " + fmt(static_cast<double>(speed) * dt) +
-               " m in one step, more than its radius " + fmt(scene_.bodies[i].radius) +
-               " m; collisions between dynamic bodies are discrete (bullet = false) and can be missed";
+        return "body '" + name + "' moved " + fmt(travel) + " m in one step, more than the " + fmt(tunnel_size_[i]) +
+               " m (its radius plus the smallest other moving body's) that discrete collision needs; "
+               "between moving bodies Box2D (bullet = false) can miss contacts";
       });
     }
   }

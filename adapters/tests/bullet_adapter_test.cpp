@@ -152,6 +152,28 @@ TEST(BulletAdapter, ManifoldBeginIsNeverLaterThanTouch) {
   EXPECT_GT(earlier, 0);
 }
 
+TEST(BulletAdapter, ContinuousCollisionIsAnOptionWithItsLimitReported) {
+  // A 5 cm ball at 100 m/s (1.67 m per step) towards a wall of no thickness that no
+  // step ends near: discrete collision misses it (and says it may), CCD catches it.
+  Scene s = empty_scene("tunnel", 1.0 / 60.0, 0.5);
+  s.bodies.push_back(circle("ball", 0.05, 1.0, {0.0, 0.0}, {100.0, 0.0}));
+  s.walls.push_back(wall("plate", {10.8, -1.0}, {10.8, 1.0}));
+  auto discrete = make_engine("bullet", s);
+  run(*discrete, s, s.steps());
+  EXPECT_GT(states(*discrete)[0].position.x, 10.8);   // tunnelled
+  EXPECT_TRUE(any_limit_starts_with(discrete->limits_hit(), "discrete_collision"));
+
+  s.engine_options["bullet"]["ccd"] = true;
+  // Bullet's CCD works through predictive contacts before touching: it needs them solved.
+  EXPECT_THROW(make_engine("bullet", s), std::invalid_argument);
+  s.engine_options["bullet"]["contact_processing_threshold"] = 1e18;
+  auto swept = make_engine("bullet", s);
+  run(*swept, s, s.steps());
+  EXPECT_LT(states(*swept)[0].position.x, 10.8);
+  EXPECT_LT(states(*swept)[0].velocity.x, 0.0);
+  EXPECT_FALSE(any_limit_starts_with(swept->limits_hit(), "discrete_collision"));
+}
+
 TEST(BulletAdapter, SettingsRecordTheElasticSafeSplitImpulse) {
   auto e = make_engine("bullet", head_on(1.0, 3.0, 2.0, -1.0, 0.001));
   const auto st = e->settings();
