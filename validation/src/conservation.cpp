@@ -100,7 +100,7 @@ Conserved conserved_quantities(const Scene& scene) {
   return c;
 }
 
-Scales characteristic_scales(const Scene& scene) {
+Scales characteristic_scales(const Scene& scene, const Series* motion) {
   Scales s;
   Vec2 lo{1e300, 1e300}, hi{-1e300, -1e300};
   auto extend = [&](Vec2 p, double r) {
@@ -132,7 +132,22 @@ Scales characteristic_scales(const Scene& scene) {
       }
     }
   }
-  s.energy = ke + mass * length(scene.world.gravity) * s.length + u;
+  double motion_energy = 0.0;
+  if (motion != nullptr && !motion->totals.empty()) {
+    double travel = 0.0, ke_max = 0.0, pe_min = 1e300, pe_max = -1e300;
+    for (std::size_t k = 0; k < motion->totals.size(); ++k) {
+      ke_max = std::max(ke_max, motion->totals[k].kinetic);
+      pe_min = std::min(pe_min, motion->totals[k].potential);
+      pe_max = std::max(pe_max, motion->totals[k].potential);
+      const auto& st = motion->states[k];
+      for (std::size_t i = 0; i < st.size() && i < scene.bodies.size(); ++i) {
+        if (st[i].alive) travel = std::max(travel, length(st[i].position - scene.bodies[i].position));
+      }
+    }
+    s.length = std::max(s.length, travel);
+    motion_energy = ke_max + (pe_max - pe_min) + u;
+  }
+  s.energy = std::max(ke + mass * length(scene.world.gravity) * s.length + u, motion_energy);
   if (!(s.energy > 0.0)) s.energy = 1.0;   // nothing moves and nothing pulls: 1 J
   s.momentum = std::max(p, std::sqrt(2.0 * mass * s.energy));
   if (!(s.momentum > 0.0)) s.momentum = 1.0;

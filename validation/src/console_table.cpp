@@ -19,6 +19,39 @@ std::string metric(const RunRecord& r, const char* name, const char* format = "%
   return it == r.metrics.end() ? "-" : num(it->second, format);
 }
 
+// Counts stay within their column: 470400 prints as 5e+05.
+std::string count(const RunRecord& r, const char* name) {
+  auto it = r.metrics.find(name);
+  if (it == r.metrics.end() || !it->second) return "-";
+  return num(it->second, *it->second < 1e4 ? "%.0f" : "%.0e");
+}
+
+// Word-wraps a note to 100 columns, continuation lines indented further.
+void note(std::ostream& os, const std::string& text) {
+  constexpr std::size_t kWidth = 100;
+  std::string line = "    ";
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find(' ', start);
+    if (end == std::string::npos) end = text.size();
+    std::string word = text.substr(start, end - start);
+    start = end + 1;
+    if (line.size() + word.size() + 1 > kWidth && line.find_first_not_of(' ') != std::string::npos) {
+      os << line << '\n';
+      line = "        ";
+    }
+    while (word.size() > kWidth - line.size()) {   // a word longer than a line
+      const std::size_t room = kWidth - line.size();
+      os << line << word.substr(0, room) << '\n';
+      word = word.substr(room);
+      line = "        ";
+    }
+    if (line.find_first_not_of(' ') != std::string::npos) line += ' ';
+    line += word;
+  }
+  if (line.find_first_not_of(' ') != std::string::npos) os << line << '\n';
+}
+
 std::string pad(std::string s, std::size_t w) {
   if (s.size() > w) s = s.substr(0, w);
   return s + std::string(w - s.size(), ' ');
@@ -39,7 +72,7 @@ void print_suite_table(std::ostream& os, const SuiteResult& result) {
     else os << ref.reason;
     os << ")\n";
     os << "  " << pad("engine", 7) << pad("status", 12) << rpad("E drift", 8) << rpad("P drift", 8) << rpad("pos div", 9)
-       << rpad("E div", 8) << rpad("contact err", 12) << rpad("steps", 6) << rpad("miss", 5) << rpad("extra", 6)
+       << rpad("E div", 8) << rpad("contact", 11) << rpad("steps", 6) << rpad("miss", 6) << rpad("extra", 6)
        << rpad("wall ms", 9) << rpad("checks", 7) << '\n';
     for (const RunRecord& r : sr.runs) {
       int pass = 0, total = 0;
@@ -60,19 +93,19 @@ void print_suite_table(std::ostream& os, const SuiteResult& result) {
       if (contact != "-") contact += " s";
       os << "  " << pad(r.engine, 7) << pad(run_status_name(r.status), 12) << rpad(metric(r, "energy_drift"), 8)
          << rpad(metric(r, "linear_momentum_drift"), 8) << rpad(metric(r, "position_divergence"), 9)
-         << rpad(metric(r, "energy_divergence"), 8) << rpad(contact, 12)
-         << rpad(metric(r, "contact_time_error_steps", "%.2f"), 6) << rpad(metric(r, "missed_contacts", "%.0f"), 5)
-         << rpad(metric(r, "extra_contacts", "%.0f"), 6)
+         << rpad(metric(r, "energy_divergence"), 8) << rpad(contact, 11)
+         << rpad(metric(r, "contact_time_error_steps", "%.2f"), 6) << rpad(count(r, "missed_contacts"), 6)
+         << rpad(count(r, "extra_contacts"), 6)
          << rpad(r.status == RunStatus::Unsupported || r.status == RunStatus::Error ? "-" : num(r.wall_seconds * 1e3, "%.2f"), 9)
          << rpad(total == 0 ? "-" : std::to_string(pass) + "/" + std::to_string(total), 7) << '\n';
     }
     for (const RunRecord& r : sr.runs) {
-      if (r.status != RunStatus::Ok) os << "    " << r.engine << ": " << r.reason << '\n';
-      for (const std::string& l : r.limits_hit) os << "    " << r.engine << " limit: " << l << '\n';
+      if (r.status != RunStatus::Ok) note(os, r.engine + ": " + r.reason);
+      for (const std::string& l : r.limits_hit) note(os, r.engine + " limit: " + l);
       for (const Check& c : r.checks) {
         if (c.pass) continue;
-        os << "    " << r.engine << (c.enforced ? " FAILED " : " missed ") << c.what << ": " << num(c.value, "%.3g")
-           << " > " << num(c.limit, "%.3g") << (c.enforced ? "" : " (reported)") << '\n';
+        note(os, r.engine + (c.enforced ? " FAILED " : " missed ") + c.what + ": " + num(c.value, "%.3g") + " > " +
+                     num(c.limit, "%.3g") + (c.enforced ? "" : " (reported)"));
       }
     }
     for (const PairComparison& p : sr.pairs) {
@@ -80,8 +113,8 @@ void print_suite_table(std::ostream& os, const SuiteResult& result) {
         auto it = p.metrics.find(k);
         return it == p.metrics.end() ? std::string("-") : num(it->second);
       };
-      os << "    " << p.a << " vs " << p.b << ": pos " << m("position_divergence") << " m, E " << m("energy_divergence")
-         << ", contacts " << m("contact_time_error") << " s\n";
+      note(os, p.a + " vs " + p.b + ": pos " + m("position_divergence") + " m, E " + m("energy_divergence") + ", contacts " +
+                   m("contact_time_error") + " s");
     }
   }
   const int runs = ok + diverged + unsupported + error;

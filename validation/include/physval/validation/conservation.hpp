@@ -30,11 +30,14 @@ Conserved conserved_quantities(const Scene& scene);
 // Characteristic values of a scene that drifts and divergences are divided by. None
 // of them can be near zero while the scene moves (a resting pile's energy can).
 struct Scales {
-  double length = 1.0;            // m: the extent of bodies and barriers
-  double energy = 1.0;            // J: KE0 + M |g| L + |U_newton(0)|
+  double length = 1.0;            // m: the extent of bodies and barriers, or how far bodies travel
+  double energy = 1.0;            // J: max(KE0 + M |g| L + |U_newton(0)|, max KE + range of PE)
   double momentum = 1.0;          // kg m/s: max(sum m |v0|, sqrt(2 M E))
   double angular_momentum = 1.0;  // kg m^2/s: sum m |x0| |v0| + P L
 };
-Scales characteristic_scales(const Scene& scene);
+// From the scene's initial state, and when `motion` is given (the reference run's
+// samples) also from how the scene moves: the largest kinetic energy, the range the
+// potential energy spans and the farthest any body travels.
+Scales characteristic_scales(const Scene& scene, const Series* motion = nullptr);
 
 }  // namespace physval
