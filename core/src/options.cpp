@@ -1,6 +1,7 @@
 #include "physval/core/options.hpp"
 
 #include <sstream>
+#include <string>
 
 namespace physval {
 
@@ -42,11 +43,15 @@ std::string option_value_to_string(const OptionValue& v) {
   struct Visitor {
     std::string operator()(bool b) const { return b ? "true" : "false"; }
     std::string operator()(std::int64_t i) const { return std::to_string(i); }
+    // The shortest decimal that reads back as the same double (0.2, not 0.20000000000000001).
     std::string operator()(double d) const {
-      std::ostringstream os;
-      os.precision(17);
-      os << d;
-      return os.str();
+      for (int digits = 6; digits <= 17; ++digits) {
+        std::ostringstream os;
+        os.precision(digits);
+        os << d;
+        if (std::stod(os.str()) == d || digits == 17) return os.str();
+      }
+      return {};
     }
     std::string operator()(const std::string& s) const { return s; }
   };
