@@ -99,6 +99,7 @@ struct Extent {
 std::string axis_commands(char name, const Axis& axis, const Extent& data, bool label_gap = false) {
   std::ostringstream os;
   const std::string a(1, name);
+  double log_step = 0.0;   // tic factor on a log axis; 0: every decade
   os << "set " << a << "label " << gp_string(axis.label + (label_gap ? "\n" : "")) << " noenhanced\n";
   if (axis.log) {
     os << "set logscale " << a << " 10\n";
@@ -111,7 +112,10 @@ std::string axis_commands(char name, const Axis& axis, const Extent& data, bool 
     } else {
       os << "set format " << a << " \"%g\"\n";
     }
-    os << "set m" << a << "tics 10\n";
+    // Many decades: a labelled tic every second or fourth decade, so labels do not collide.
+    const double decades = data.empty() ? 0.0 : std::log10(hi / lo);
+    log_step = decades > 16.0 ? 10000.0 : (decades > 8.0 ? 100.0 : 0.0);
+    os << "set m" << a << "tics " << (log_step > 0.0 ? "default" : "10") << "\n";
   } else {
     os << "unset logscale " << a << "\nset format " << a << " \"%g\"\nset m" << a << "tics default\n";
   }
@@ -125,7 +129,11 @@ std::string axis_commands(char name, const Axis& axis, const Extent& data, bool 
     if (axis.tic_rotation != 0) os << " rotate by " << axis.tic_rotation << (name == 'x' ? " right" : "");
     os << " noenhanced\n";
   } else {
-    os << "set " << a << "tics auto norotate enhanced\n";
+    if (log_step > 0.0) {
+      os << "set " << a << "tics " << number(log_step) << " norotate enhanced\n";
+    } else {
+      os << "set " << a << "tics auto norotate enhanced\n";
+    }
   }
   os << "set " << a << "range [" << (axis.min ? number(*axis.min) : std::string("*")) << ':'
      << (axis.max ? number(*axis.max) : std::string("*")) << "]\n";
@@ -166,7 +174,8 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
   os << "set tics out nomirror\n";
   const bool multi = figure.panels.size() > 1;
   if (multi) {
-    os << "set multiplot layout " << figure.panels.size() << ",1";
+    const std::size_t columns = static_cast<std::size_t>(std::max(1, figure.columns));
+    os << "set multiplot layout " << (figure.panels.size() + columns - 1) / columns << ',' << columns;
     if (!figure.title.empty()) os << " title " << gp_string(figure.title) << " font ',13' noenhanced";
     os << "\n";
   }

@@ -417,7 +417,7 @@ void write_report(const fs::path& dir, const Progress& progress) {
     page << figure_html(draw(trajectory_figure(v, engines), base + "_trajectories", v.name + " trajectories",
                              "The path of each body in each engine, drawn over the reference's (thick grey). Equal "
                              "scales on both axes."));
-    if (auto contacts = contact_figure(v)) {
+    if (auto contacts = contact_figure(v, engines)) {
       page << figure_html(draw(*contacts, base + "_contacts", v.name + " contact timeline",
                                "One row per engine: where it reported a contact beginning, coloured by the pair in "
                                "contact. Grey vertical lines: the reference's contact times."));

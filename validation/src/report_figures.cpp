@@ -213,7 +213,7 @@ plot::Figure trajectory_figure(const ScenarioView& v, const std::vector<std::str
   plot::Panel p;
   p.x.label = "x (m)";
   p.y.label = "y (m)";
-  p.key = "outside right top";
+  p.key = "below center horizontal Left reverse";
   p.equal_aspect = true;
   std::set<std::string> labelled;
   std::size_t body_total = 0;
@@ -262,7 +262,7 @@ plot::Figure trajectory_figure(const ScenarioView& v, const std::vector<std::str
     }
   }
   if (!ex.empty()) {
-    constexpr double kPlotAspect = 1.15;   // width / height of the plot area, m per m
+    constexpr double kPlotAspect = 1.5;   // width / height of the plot area, m per m
     double xs = ex.hi - ex.lo, ys = ey.hi - ey.lo;
     const double floor_span = std::max({xs, ys, 1e-3});
     xs = std::max(xs, 0.05 * floor_span);
@@ -289,6 +289,9 @@ plot::Figure trajectory_figure(const ScenarioView& v, const std::vector<std::str
 
 namespace {
 
+// Beyond this many contacts in one row, the timeline becomes a contact rate.
+constexpr std::size_t kMaxTimelineContacts = 150;
+
 struct ContactPoint {
   std::string pair;
   double time = 0.0;
@@ -311,7 +314,7 @@ std::vector<ContactPoint> contacts_of(const json& holder) {
 }  // namespace
 
 // Rows top to bottom: the reference, then each engine.
-std::optional<plot::Figure> contact_figure(const ScenarioView& v) {
+std::optional<plot::Figure> contact_figure(const ScenarioView& v, const std::vector<std::string>& engines) {
   struct Row {
     std::string label;
     std::vector<ContactPoint> contacts;
@@ -331,6 +334,37 @@ std::optional<plot::Figure> contact_figure(const ScenarioView& v) {
     total += r.contacts.size();
   }
   if (total == 0) return std::nullopt;
+  std::size_t busiest = 0;
+  for (const Row& r : rows) busiest = std::max(busiest, r.contacts.size());
+  if (busiest > kMaxTimelineContacts) {
+    // Too many to tell apart as points (a gas): the rate at which contacts begin.
+    double span = v.duration;
+    for (const Row& r : rows) {
+      for (const ContactPoint& c : r.contacts) span = std::max(span, c.time);
+    }
+    constexpr int kBins = 50;
+    const double width = span / kBins;
+    plot::Figure fig;
+    fig.title = v.name + ": contact rate";
+    plot::Panel p;
+    p.title = "contacts begun per second, in " + fmt(width) + " s bins (too many contacts to show one by one)";
+    p.x.label = "time (s)";
+    p.y.label = "contacts begun per second (1/s)";
+    p.key = "outside right top";
+    for (const Row& r : rows) {
+      std::vector<double> counts(kBins, 0.0);
+      for (const ContactPoint& c : r.contacts) {
+        const int bin = std::clamp(static_cast<int>(c.time / width), 0, kBins - 1);
+        counts[static_cast<std::size_t>(bin)] += 1.0 / width;
+      }
+      std::vector<double> centres(kBins);
+      for (int b = 0; b < kBins; ++b) centres[static_cast<std::size_t>(b)] = (b + 0.5) * width;
+      Source source{r.label, r.label == "reference" ? "" : r.label, {}};
+      p.series.push_back(curve(source, engines, centres, counts));
+    }
+    fig.panels.push_back(std::move(p));
+    return fig;
+  }
 
   // The most frequent pairs get a colour each; the rest share one.
   constexpr std::size_t kMaxPairs = 8;
@@ -394,9 +428,13 @@ std::optional<plot::Figure> contact_figure(const ScenarioView& v) {
 
 // Every scenario's position and energy divergence, one point per engine.
 plot::Figure overview_figure(const std::vector<ScenarioView>& views, const std::vector<std::string>& engines) {
+  // Scenarios are rows (top to bottom in suite order), so their names read
+  // horizontally; the two measures side by side share the rows.
   plot::Figure fig;
-  fig.title = "all scenarios: how far each engine strays from the reference";
-  fig.height = 850;
+  fig.title = "all scenarios: how far each engine strays from the reference (a missing point: not measured, or zero)";
+  fig.width = 1100;
+  fig.columns = 2;
+  fig.height = std::max(420, 150 + 22 * static_cast<int>(views.size()));
   struct Part {
     const char* metric;
     const char* title;
@@ -404,21 +442,24 @@ plot::Figure overview_figure(const std::vector<ScenarioView>& views, const std::
   };
   const Part parts[] = {{"position_divergence", "max position divergence", "position divergence (m, log scale)"},
                         {"energy_divergence", "energy divergence", "energy divergence (relative, log scale)"}};
-  for (const Part& part : parts) {
+  const double n = static_cast<double>(views.size());
+  auto row = [&](std::size_t i) { return n - static_cast<double>(i); };
+  for (std::size_t k = 0; k < 2; ++k) {
+    const Part& part = parts[k];
     plot::Panel p;
-    p.title = part.title + std::string(" (missing point: not measured, or exactly zero)");
-    p.y.label = part.unit;
-    p.y.log = true;
-    p.key = "outside right top";
-    p.x.min = 0.5;
-    p.x.max = static_cast<double>(views.size()) + 0.5;
-    p.x.tic_rotation = views.size() > 4 ? 25 : 0;
-    for (std::size_t i = 0; i < views.size(); ++i) p.x.tics.emplace_back(static_cast<double>(i + 1), views[i].name);
+    p.title = part.title;
+    p.x.label = part.unit;
+    p.x.log = true;
+    p.key = k == 0 ? "off" : "outside right top";
+    p.y.min = 0.4;
+    p.y.max = n + 0.6;
+    // Names once, on the left panel; the right one keeps the rows, unlabelled.
+    for (std::size_t i = 0; i < views.size(); ++i) p.y.tics.emplace_back(row(i), k == 0 ? views[i].name : "");
     for (const std::string& engine : engines) {
       plot::Series s;
       s.title = engine;
       s.style = plot::Style::Points;
-      s.point_size = 1.8;
+      s.point_size = 1.6;
       const Look l = look_of(engines, engine);
       s.color = l.colour;
       s.point_type = std::vector<int>{7, 5, 9, 13, 11}[static_cast<std::size_t>(l.colour) % 5];
@@ -426,8 +467,8 @@ plot::Figure overview_figure(const std::vector<ScenarioView>& views, const std::
         for (const json* run : views[i].runs) {
           if (str(*run, "engine") != engine) continue;
           if (auto m = num(member(*run, "metrics"), part.metric)) {
-            s.x.push_back(static_cast<double>(i + 1));
-            s.y.push_back(*m);
+            s.x.push_back(*m);
+            s.y.push_back(row(i));
           }
         }
       }

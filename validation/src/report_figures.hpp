@@ -69,7 +69,8 @@ plot::Figure energy_figure(const ScenarioView& v, const std::vector<std::string>
 plot::Figure momentum_figure(const ScenarioView& v, const std::vector<std::string>& engines);
 plot::Figure trajectory_figure(const ScenarioView& v, const std::vector<std::string>& engines);
 // nullopt when no run and no reference has a contact.
-std::optional<plot::Figure> contact_figure(const ScenarioView& v);
+// Points per contact, or the rate of contacts when there are too many to show.
+std::optional<plot::Figure> contact_figure(const ScenarioView& v, const std::vector<std::string>& engines);
 // Every scenario's position and energy divergence, one point per engine.
 plot::Figure overview_figure(const std::vector<ScenarioView>& views, const std::vector<std::string>& engines);
 

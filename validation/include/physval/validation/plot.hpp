@@ -66,7 +66,8 @@ struct Panel {
 
 struct Figure {
   std::string title;               // over all panels ("" for none)
-  std::vector<Panel> panels;       // stacked top to bottom
+  std::vector<Panel> panels;       // row by row, `columns` to a row
+  int columns = 1;
   int width = 1000;                // pixels
   int height = 650;
 };
