@@ -88,7 +88,8 @@ std::vector<OptionSpec> bullet_options() {
       {"contact_begin", std::string("touch"), {"touch", "manifold"},
        "When a pair's contact begins: 'touch' = the first step after which the pair's manifold has a point "
        "at distance <= 0 or a normal impulse > 0; 'manifold' = its first manifold point at all "
-       "(gContactStartedCallback), which Bullet creates up to its breaking threshold before touching."},
+       "(gContactStartedCallback), which Bullet creates up to its breaking threshold before touching. "
+       "Bullet writes impulses back only with warm starting; without it 'touch' means distance <= 0."},
   };
 }
 
