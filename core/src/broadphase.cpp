@@ -78,10 +78,9 @@ class AllPairsBroadPhase final : public bp_detail::BroadPhaseBase {
     }
   }
 
-  void query(std::uint32_t i, std::vector<std::uint32_t>& out) override {
-    const Aabb& a = boxes_[i];
+  void query_box(const Aabb& a, std::uint32_t exclude, std::vector<std::uint32_t>& out) override {
     for (std::uint32_t j : list_) {
-      if (j != i && overlaps(a, boxes_[j])) out.push_back(j);
+      if (j != exclude && overlaps(a, boxes_[j])) out.push_back(j);
     }
   }
 

@@ -110,10 +110,9 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     }
   }
 
-  void query(std::uint32_t i, std::vector<std::uint32_t>& out) override {
+  void query_box(const Aabb& q, std::uint32_t exclude, std::vector<std::uint32_t>& out) override {
     const std::uint32_t stamp = next_stamp();
-    stamp_[i] = stamp;
-    const Aabb& q = boxes_[i];
+    if (exclude < stamp_.size()) stamp_[exclude] = stamp;
     const double half = 0.5 * cell_;
     const std::int32_t x0 = bp_detail::cell_of(q.min_x - half, inv_cell_);
     const std::int32_t x1 = bp_detail::cell_of(q.max_x + half, inv_cell_);

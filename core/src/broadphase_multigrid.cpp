@@ -105,12 +105,11 @@ class MultiGridBroadPhase final : public bp_detail::BroadPhaseBase {
     }
   }
 
-  void query(std::uint32_t i, std::vector<std::uint32_t>& out) override {
+  void query_box(const Aabb& q, std::uint32_t exclude, std::vector<std::uint32_t>& out) override {
     const std::uint32_t stamp = next_stamp();
-    stamp_[i] = stamp;
-    const Aabb& q = boxes_[i];
+    if (exclude < stamp_.size()) stamp_[exclude] = stamp;
     const CellRange r = range(q);
-    if (big_[i] || r.count() > static_cast<std::int64_t>(boxes_.size())) {
+    if (r.count() > std::max<std::int64_t>(kMaxCells, static_cast<std::int64_t>(boxes_.size()))) {
       for (std::uint32_t j = 0; j < boxes_.size(); ++j) {
         if (active_[j] && first_visit(j, stamp) && overlaps(q, boxes_[j])) out.push_back(j);
       }

@@ -60,8 +60,7 @@ class SortSweepBroadPhase final : public bp_detail::BroadPhaseBase {
     }
   }
 
-  void query(std::uint32_t i, std::vector<std::uint32_t>& out) override {
-    const Aabb& q = boxes_[i];
+  void query_box(const Aabb& q, std::uint32_t i, std::vector<std::uint32_t>& out) override {
     const double lo = static_cast<double>(q.min_x) - max_reach_;
     const double hi = static_cast<double>(q.max_x) + max_lead_;
     auto it = std::lower_bound(keys_.begin(), keys_.end(), lo,

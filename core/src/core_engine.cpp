@@ -101,7 +101,7 @@ BodyMeta CoreEngine::body_meta(std::size_t i) const {
   BodyMeta m;
   const auto k = static_cast<std::uint32_t>(i);
   if (i < w.scene_bodies) {
-    m.name = w.names[i];
+    m.name = w.name(i);
   } else {
     const std::size_t p = i - w.scene_bodies;
     m.name = w.emitters[w.emitter_of[p]].def.name + "#" + std::to_string(w.serial[p]);

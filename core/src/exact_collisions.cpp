@@ -195,17 +195,40 @@ class EventLoop {
   }
 
   // Body i's path changed at time t: register its new path and find its next events.
-  void reschedule(std::uint32_t i, double t, std::uint32_t exclude) {
+  void reschedule(std::uint32_t i, double t) {
     if (!w_.alive(i)) return;
     const Aabb box = path_box(w_, i, t, T_);
     w_.bp->grow(i, box);
     w_.found.clear();
     w_.bp->query(i, w_.found);
-    for (std::uint32_t j : w_.found) {
-      if (j != exclude) schedule_pair(i, j, t);
-    }
+    for (std::uint32_t j : w_.found) schedule_pair(i, j, t);
     if (w_.dynamic(i)) schedule_statics(i, t, box);
     schedule_body(i, t);
+  }
+
+  // Both bodies of an impact changed their paths: one broad-phase query for the two.
+  void reschedule_pair(std::uint32_t i, std::uint32_t j, double t) {
+    const bool ai = w_.alive(i), aj = w_.alive(j);
+    if (!ai || !aj) {
+      if (ai) reschedule(i, t);
+      if (aj) reschedule(j, t);
+      return;
+    }
+    const Aabb box_i = path_box(w_, i, t, T_), box_j = path_box(w_, j, t, T_);
+    w_.bp->grow(i, box_i);
+    w_.bp->grow(j, box_j);
+    const Aabb reg_i = w_.bp->box(i), reg_j = w_.bp->box(j);
+    w_.found.clear();
+    w_.bp->query_box(merge(reg_i, reg_j), kNone, w_.found);
+    for (std::uint32_t k : w_.found) {
+      const Aabb& reg_k = w_.bp->box(k);
+      if (k != i && overlaps(reg_i, reg_k)) schedule_pair(i, k, t);   // includes (i, j)
+      if (k != i && k != j && overlaps(reg_j, reg_k)) schedule_pair(j, k, t);
+    }
+    if (w_.dynamic(i)) schedule_statics(i, t, box_i);
+    if (w_.dynamic(j)) schedule_statics(j, t, box_j);
+    schedule_body(i, t);
+    schedule_body(j, t);
   }
 
   // A velocity change by another body: a supported body lifted off (or driven into)
@@ -235,13 +258,13 @@ class EventLoop {
         w_.vel[e.a] = {};
         support_path(w_, e.a);
         ++w_.version[e.a];
-        reschedule(e.a, e.time, kNone);
+        reschedule(e.a, e.time);
         break;
       case EventKind::Leave:
         w_.advance(e.a, e.time);
         release_support(w_, e.a);
         ++w_.version[e.a];
-        reschedule(e.a, e.time, kNone);
+        reschedule(e.a, e.time);
         break;
       case EventKind::Expire:
         w_.advance(e.a, e.time);
@@ -287,8 +310,7 @@ class EventLoop {
     ++w_.version[j];
     destroy_after(i, r.destroy_first);
     destroy_after(j, r.destroy_second);
-    reschedule(i, t, kNone);
-    reschedule(j, t, i);
+    reschedule_pair(i, j, t);
   }
 
   void process_static(std::uint32_t i, std::uint32_t k, std::uint8_t feature, double t, double t_abs) {
@@ -359,7 +381,7 @@ class EventLoop {
     if (r.event) record_contact(w_, i, kNone, &seg, t_abs, ctx_.dt);
     ++w_.version[i];
     destroy_after(i, r.destroy_first);
-    reschedule(i, t, kNone);
+    reschedule(i, t);
   }
 
   void finish_with_lecture_pass(double t) {

@@ -151,7 +151,14 @@ struct World {
   std::vector<Vec2> support_n;
   std::vector<std::uint32_t> last_partner;   // any_forces: contact continuity
   std::vector<double> last_touch;
-  std::vector<std::string> names;    // scene bodies only (particles are named on demand)
+  // Names of the scene's bodies, packed: body i is name_chars[name_end[i-1], name_end[i])
+  // (particles are named on demand).
+  std::string name_chars;
+  std::vector<std::uint32_t> name_end;
+  std::string name(std::size_t i) const {
+    const std::uint32_t b = i == 0 ? 0 : name_end[i - 1];
+    return name_chars.substr(b, name_end[i] - b);
+  }
 
   // ---- particles (index i - scene_bodies)
   std::vector<EmitterState> emitters;

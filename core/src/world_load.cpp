@@ -181,7 +181,8 @@ void load_world(World& w, const Scene& scene) {
   }
   const std::size_t cap = scene.bodies.size() + particles;
   auto reserve_all = [&](auto&... v) { (v.reserve(cap), ...); };
-  reserve_all(w.pos, w.vel, w.tloc, w.inv_mass, w.radius, w.version, w.flags, w.group, w.material, w.names);
+  reserve_all(w.pos, w.vel, w.tloc, w.inv_mass, w.radius, w.version, w.flags, w.group, w.material);
+  w.name_end.reserve(scene.bodies.size());
   if (w.newtonian) w.mass.reserve(cap);
   if (any_thrust) w.angle.reserve(cap);
   if (any_drag || any_thrust) w.fparams.reserve(cap);
@@ -208,7 +209,8 @@ void load_world(World& w, const Scene& scene) {
     w.group.push_back(b.group_id(d.group));
     w.material.push_back(b.material_id(d.name, d.restitution, d.friction, std::max(d.static_friction, d.friction),
                                        d.rolling_friction));
-    w.names.push_back(d.name);
+    w.name_chars += d.name;
+    w.name_end.push_back(static_cast<std::uint32_t>(w.name_chars.size()));
     if (w.newtonian) w.mass.push_back(d.mass);
     if (any_thrust) w.angle.push_back(d.angle);
     if (any_drag || any_thrust) {
@@ -320,10 +322,8 @@ std::size_t World::memory_bytes() const {
   n += bytes_of(pos) + bytes_of(vel) + bytes_of(tloc) + bytes_of(inv_mass) + bytes_of(radius) + bytes_of(version);
   n += bytes_of(flags) + bytes_of(group) + bytes_of(material) + bytes_of(mass) + bytes_of(angle);
   n += bytes_of(acc) + bytes_of(apath) + bytes_of(vcorr) + bytes_of(fparams) + bytes_of(support);
-  n += bytes_of(support_n) + bytes_of(last_partner) + bytes_of(last_touch) + bytes_of(names);
-  for (const std::string& s : names) {
-    if (s.capacity() > 15) n += s.capacity() + 1;   // beyond the small-string buffer
-  }
+  n += bytes_of(support_n) + bytes_of(last_partner) + bytes_of(last_touch) + bytes_of(name_end);
+  n += name_chars.capacity() + 1;
   n += bytes_of(birth) + bytes_of(lifetime) + bytes_of(parent) + bytes_of(emitters);
   n += statics.memory_bytes() + bytes_of(material_table) + bytes_of(responses) + bytes_of(materials);
   n += bp ? bp->memory_bytes() : 0;

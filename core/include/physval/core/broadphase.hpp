@@ -8,8 +8,10 @@
 // boxes, so they differ only in cost.
 #pragma once
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <string>
@@ -23,13 +25,24 @@ struct Aabb {
   float min_x = 0.0f, min_y = 0.0f, max_x = -1.0f, max_y = -1.0f;
 };
 
+// The float next to f towards -inf / +inf (finite, non-NaN f), without a libm call.
+inline float float_below(float f) {
+  if (f == 0.0f) return -std::numeric_limits<float>::denorm_min();
+  const auto b = std::bit_cast<std::uint32_t>(f);
+  return std::bit_cast<float>(f > 0.0f ? b - 1u : b + 1u);
+}
+inline float float_above(float f) {
+  if (f == 0.0f) return std::numeric_limits<float>::denorm_min();
+  const auto b = std::bit_cast<std::uint32_t>(f);
+  return std::bit_cast<float>(f > 0.0f ? b + 1u : b - 1u);
+}
 inline float round_down(double v) {
-  float f = static_cast<float>(v);
-  return static_cast<double>(f) > v ? std::nextafter(f, -INFINITY) : f;
+  const float f = static_cast<float>(v);
+  return static_cast<double>(f) > v && std::isfinite(f) ? float_below(f) : f;
 }
 inline float round_up(double v) {
-  float f = static_cast<float>(v);
-  return static_cast<double>(f) < v ? std::nextafter(f, INFINITY) : f;
+  const float f = static_cast<float>(v);
+  return static_cast<double>(f) < v && std::isfinite(f) ? float_above(f) : f;
 }
 inline Aabb make_aabb(double min_x, double min_y, double max_x, double max_y) {
   return {round_down(min_x), round_down(min_y), round_up(max_x), round_up(max_y)};
@@ -83,7 +96,11 @@ class BroadPhase {
   virtual void pairs(std::vector<BodyPair>& out) = 0;
 
   // Appends every active body j != i whose registered box overlaps i's, once each.
-  virtual void query(std::uint32_t i, std::vector<std::uint32_t>& out) = 0;
+  void query(std::uint32_t i, std::vector<std::uint32_t>& out) { query_box(box(i), i, out); }
+
+  // Appends every active body j != exclude whose registered box overlaps `box`, once
+  // each (one query for the two bodies of an impact).
+  virtual void query_box(const Aabb& box, std::uint32_t exclude, std::vector<std::uint32_t>& out) = 0;
 
   // Extends body i's registered box to also cover `box` (a body whose path changed
   // mid-step). Activates i if it was inactive. Later queries see the new box.
