@@ -14,9 +14,11 @@
 #include "physval/adapters/registry.hpp"
 #include "physval/validation/console_table.hpp"
 #include "physval/validation/gate.hpp"
+#include "physval/validation/report.hpp"
 #include "physval/validation/results_json.hpp"
 #include "physval/validation/scenario_loader.hpp"
 #include "physval/validation/suite.hpp"
+#include "physval/validation/sweep.hpp"
 
 namespace {
 
@@ -88,8 +90,17 @@ std::optional<std::vector<Scene>> load_or_report(const std::vector<std::string>&
   return std::move(load.scenes);
 }
 
+Progress terminal_progress(bool quiet) {
+  if (quiet || ::isatty(2) == 0) return {};
+  return [](const std::string& line) { std::cerr << "\r\033[K  " << line.substr(0, 90) << std::flush; };
+}
+
+void end_progress(const Progress& progress) {
+  if (progress) std::cerr << "\r\033[K" << std::flush;
+}
+
 int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, const std::string& baseline_path,
-                double baseline_factor) {
+                double baseline_factor, bool report) {
   RunOptions options;
   if (!o.dt.empty()) {
     options.dt = parse_seconds(o.dt);
@@ -120,13 +131,10 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
   auto scenes = load_or_report(o.paths);
   if (!scenes) return kExitBadInput;
 
-  const bool tty = ::isatty(2) != 0;
-  Progress progress;
-  if (tty && !o.quiet) {
-    progress = [](const std::string& line) { std::cerr << "\r\033[K  running " << line << std::flush; };
-  }
-  SuiteResult result = run_suite(*scenes, o.engines, options, gate, progress);
-  if (progress) std::cerr << "\r\033[K" << std::flush;
+  const Progress progress = terminal_progress(o.quiet);
+  SuiteResult result = run_suite(*scenes, o.engines, options, gate,
+                                 progress ? Progress([&](const std::string& l) { progress("running " + l); }) : Progress{});
+  end_progress(progress);
   if (!baseline_path.empty()) {
     const int matched = apply_baseline(result, baseline, baseline_factor);
     std::cout << "baseline: " << matched << " runs matched in " << baseline_path << " (regression factor "
@@ -147,6 +155,11 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
     if (!junit.empty()) {
       write_file_atomically(junit, junit_xml(result));
       std::cout << "junit: " << junit << '\n';
+    }
+    if (report) {
+      write_report(o.out, progress);
+      end_progress(progress);
+      std::cout << "report: " << (std::filesystem::path(o.out) / "report.html").string() << '\n';
     }
   } catch (const std::exception& e) {
     std::cerr << "physval: could not write the results: " << e.what() << '\n';
@@ -232,10 +245,32 @@ int main(int argc, char** argv) {
   gate->add_option("--baseline", baseline, "an earlier results.json: fail on a regression beyond --baseline-factor");
   gate->add_option("--baseline-factor", baseline_factor, "how much worse than the baseline an error metric may get")
       ->capture_default_str();
+  bool gate_report = false;
+  gate->add_flag("--report", gate_report, "also write DIR/report.html with plots");
 
   std::vector<std::string> check_paths;
   auto* check = app.add_subcommand("check", "parse and validate scenario files; runs nothing");
   check->add_option("PATH", check_paths, "scenario files or folders")->required();
+
+  std::string sweep_scenario, sweep_out = "physval-sweep", sweep_duration;
+  std::vector<std::string> sweep_dts, sweep_engines;
+  int sweep_repetitions = 5;
+  bool sweep_no_settings = false, sweep_quiet = false;
+  auto* sweep = app.add_subcommand("sweep", "speed against error: one scenario over step sizes and solver settings");
+  sweep->add_option("SCENARIO", sweep_scenario, "one scenario file")->required();
+  sweep->add_option("--dt", sweep_dts, "step sizes, comma-separated (default 1/30,1/60,1/120,1/240,1/480,1/960)")
+      ->delimiter(',');
+  sweep->add_option("--engines", sweep_engines, "engines to sweep, comma-separated (default: all that can)")->delimiter(',');
+  sweep->add_option("--out", sweep_out, "output folder: sweep.csv, sweep.json and the plots")->capture_default_str();
+  sweep->add_option("--repetitions", sweep_repetitions, "timed repetitions per point (the median is reported)")
+      ->capture_default_str();
+  sweep->add_option("--duration", sweep_duration, "override the scenario's duration, seconds");
+  sweep->add_flag("--no-settings", sweep_no_settings, "sweep step sizes only, each engine at its default settings");
+  sweep->add_flag("--quiet", sweep_quiet, "no progress on the terminal");
+
+  std::string report_dir;
+  auto* report = app.add_subcommand("report", "write report.html with plots for a results folder of `run` or `gate`");
+  report->add_option("DIR", report_dir, "the folder holding results.json and series/")->required();
 
   bool engines_json = false;
   auto* engines = app.add_subcommand("engines", "each engine, its version, precision, options and what it can model");
@@ -263,12 +298,52 @@ int main(int argc, char** argv) {
       print_engines(engines_json);
       return 0;
     }
-    if (*run) {
-      const int status = run_or_gate(run_opts, false, "", "", 2.0);
-      (void)run_report;
-      return status;
+    if (*run) return run_or_gate(run_opts, false, "", "", 2.0, run_report);
+    if (*gate) return run_or_gate(gate_opts, true, junit, baseline, baseline_factor, gate_report);
+    if (*report) {
+      if (!std::filesystem::exists(std::filesystem::path(report_dir) / "results.json")) {
+        return bad_input(report_dir + ": no results.json here (write one with `physval run PATH --out " + report_dir + "`)");
+      }
+      const Progress progress = terminal_progress(false);
+      write_report(report_dir, progress);
+      end_progress(progress);
+      std::cout << "report: " << (std::filesystem::path(report_dir) / "report.html").string() << '\n';
+      return 0;
     }
-    if (*gate) return run_or_gate(gate_opts, true, junit, baseline, baseline_factor);
+    if (*sweep) {
+      SweepOptions so;
+      if (!sweep_dts.empty()) {
+        so.dts.clear();
+        for (const std::string& d : sweep_dts) {
+          auto v = parse_seconds(d);
+          if (!v) return bad_input("--dt: expected positive step sizes such as 1/60 or 0.01, got \"" + d + "\"");
+          so.dts.push_back(*v);
+        }
+      }
+      for (const std::string& e : sweep_engines) {
+        if (find_engine(e) == nullptr) return bad_input("--engines: no engine named \"" + e + "\" (see `physval engines`)");
+      }
+      if (sweep_repetitions < 1) return bad_input("--repetitions must be >= 1");
+      so.engines = sweep_engines;
+      so.repetitions = sweep_repetitions;
+      so.settings = !sweep_no_settings;
+      ScenarioLoad load = load_scenario_file(sweep_scenario);
+      for (const Diagnostic& d : load.errors) std::cerr << d.str() << '\n';
+      if (!load.scene) return kExitBadInput;
+      if (!sweep_duration.empty()) {
+        auto d = parse_seconds(sweep_duration);
+        if (!d) return bad_input("--duration: expected a positive number of seconds, got \"" + sweep_duration + "\"");
+        load.scene->duration = *d;
+      }
+      const Progress progress = terminal_progress(sweep_quiet);
+      SweepResult result = run_sweep(*load.scene, so, progress);
+      end_progress(progress);
+      print_sweep_table(std::cout, result);
+      write_sweep(sweep_out, result);
+      std::cout << "sweep: " << (std::filesystem::path(sweep_out) / "sweep.csv").string() << ", sweep.json, "
+                << "speed_vs_error.png, error_vs_dt.png in " << sweep_out << '\n';
+      return 0;
+    }
   } catch (const std::exception& e) {
     std::cerr << "physval: " << e.what() << '\n';
     return kExitBadInput;
