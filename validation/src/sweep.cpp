@@ -105,6 +105,20 @@ RunRecord run_once(const Scene& scene, const EngineFactory& engine, const RunOpt
   }
 }
 
+RunRecord run_once_isolated(const Scene& scene, const EngineFactory& engine, const RunOptions& options) {
+  try {
+    return run_engine_isolated(scene, engine, options);
+  } catch (const std::exception& e) {
+    RunRecord r;
+    r.scenario = scene.name;
+    r.engine = engine.info.name;
+    r.dt = scene.dt;
+    r.status = RunStatus::Error;
+    r.reason = e.what();
+    return r;
+  }
+}
+
 std::optional<double> metric(const RunRecord& run, const char* name) {
   auto it = run.metrics.find(name);
   if (it == run.metrics.end() || !it->second || !std::isfinite(*it->second)) return std::nullopt;
@@ -269,7 +283,7 @@ SweepResult run_sweep(const Scene& scene, const SweepOptions& options, const Pro
         ++done;
         RunOptions ro;
         ro.dt = dt;
-        ro.isolate = false;   // in-process: timing without a fork; failures are caught
+        ro.isolate = false;   // timing runs in this process (no fork in the measurement)
         const Scene run_scene = effective_scene(configured, ro);
 
         SweepPoint p;
@@ -280,8 +294,13 @@ SweepResult run_sweep(const Scene& scene, const SweepOptions& options, const Pro
         p.simulated_seconds = static_cast<double>(p.steps) * dt;
 
         // The first run is measured for error (runs are deterministic) and warms up.
-        // The comparison may find the run diverged (energy running away).
-        RunRecord first = run_once(run_scene, engine, ro);
+        // The first run, in a child process, is the one measured for error: an engine
+        // that crashes costs its point, not the sweep. Only a run that came back whole
+        // is repeated in this process for timing (engines are deterministic). The
+        // comparison may still find it diverged (energy running away).
+        RunOptions isolated = ro;
+        isolated.isolate = true;
+        RunRecord first = run_once_isolated(run_scene, engine, isolated);
         if (first.status == RunStatus::Ok) {
           try {
             compare_run(first, run_scene, reference, false);
