@@ -313,6 +313,7 @@ SweepResult run_sweep(const Scene& scene, const SweepOptions& options, const Pro
         }
         p.status = first.status;
         p.reason = first.reason;
+        p.engine_settings = first.settings;
         if (p.status == RunStatus::Ok) time_point(p, run_scene, engine, ro, options);
 
         std::string line = "[" + std::to_string(done) + "/" + std::to_string(total) + "] " + p.engine +

@@ -272,6 +272,9 @@ void analyse_sweep(SweepResult& result) {
       pos.push_back(p.position_error);
       energy.push_back(p.energy_error);
     }
+    for (std::size_t i : indices) {
+      if (o.engine_settings.empty()) o.engine_settings = result.points[i].engine_settings;
+    }
     o.position = fit_log_log(dts, pos);
     o.energy = fit_log_log(dts, energy);
     result.orders.push_back(std::move(o));
@@ -433,8 +436,10 @@ nlohmann::json sweep_to_json(const SweepResult& r) {
   j["points"] = std::move(points);
   nlohmann::json orders = nlohmann::json::array();
   for (const ConvergenceOrder& o : r.orders) {
+    nlohmann::json settings = nlohmann::json::object();
+    for (const auto& [key, value] : o.engine_settings) settings[key] = value;
     orders.push_back({{"engine", o.engine}, {"setting", o.setting}, {"position", fit_json(o.position)},
-                      {"energy", fit_json(o.energy)}});
+                      {"energy", fit_json(o.energy)}, {"engine_settings", settings}});
   }
   j["orders"] = std::move(orders);
   j["notes"] = r.notes;

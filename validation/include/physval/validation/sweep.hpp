@@ -68,6 +68,7 @@ struct SweepPoint {
   std::optional<double> energy_error;         // energy divergence (relative)
   std::optional<double> contact_time_error;   // s
   bool pareto = false;                // on the speed-against-position-error front
+  std::vector<Setting> engine_settings;   // every setting the engine ran with (its own report)
 };
 
 // A least-squares line through (log10 x, log10 y) of the points with x, y > 0.
@@ -85,6 +86,7 @@ struct ConvergenceOrder {
   std::string setting;
   LogLogFit position;                 // slope of log(position error) vs log(dt)
   LogLogFit energy;                   // the same for the energy error
+  std::vector<Setting> engine_settings;   // as the engine reported them (from its first run)
 };
 
 struct SweepResult {
