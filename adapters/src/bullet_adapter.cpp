@@ -301,9 +301,8 @@ btRigidBody* BulletEngine::add_static(btCollisionShape* shape, const btTransform
   return statics_.back().get();
 }
 
-// A static box with half extents (hx, hy) in the plane, its centre at c, rotated by
-// `angle` about z, with collision margin `margin` (btBoxShape keeps the outer extents).
-static btTransform planar_transform(Vec2 c, double angle) {
+// A placement in the plane z = 0: origin c, rotated by `angle` about z.
+btTransform planar_transform(Vec2 c, double angle) {
   btTransform xf;
   xf.setIdentity();
   xf.setOrigin(to_bt(c));
