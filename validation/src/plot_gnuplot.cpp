@@ -135,8 +135,15 @@ std::string axis_commands(char name, const Axis& axis, const Extent& data, bool 
       os << "set " << a << "tics auto norotate enhanced\n";
     }
   }
-  os << "set " << a << "range [" << (axis.min ? number(*axis.min) : std::string("*")) << ':'
-     << (axis.max ? number(*axis.max) : std::string("*")) << "]\n";
+  // A log axis gets a margin of a factor 2 beyond its data, so points at the extremes
+  // are not drawn on the border; a linear axis extends to its next tics by itself.
+  std::optional<double> lo = axis.min, hi = axis.max;
+  if (axis.log && !data.empty()) {
+    if (!lo) lo = data.lo / 2.0;
+    if (!hi) hi = data.hi * 2.0;
+  }
+  os << "set " << a << "range [" << (lo ? number(*lo) : std::string("*")) << ':'
+     << (hi ? number(*hi) : std::string("*")) << "]\n";
   return os.str();
 }
 

@@ -127,6 +127,9 @@ std::string order_text(const LogLogFit& f) {
 // the slope is reported but flagged.
 constexpr double kGoodFit = 0.9;
 
+// Position errors at or below this (m) are round-off, not truncation error.
+constexpr double kRoundOff = 1e-9;
+
 plot::Figure speed_vs_error_figure(const SweepResult& r) {
   plot::Figure fig;
   fig.height = figure_height(groups_of(r).size() + 1);
@@ -193,7 +196,9 @@ plot::Figure error_vs_dt_figure(const SweepResult& r) {
       return o.engine == first.engine && o.setting == first.setting;
     });
     std::string order_note = "order n/a";
-    if (order != r.orders.end() && order->position.slope) {
+    if (order != r.orders.end() && order->exact_to_round_off) {
+      order_note = "exact to round-off";
+    } else if (order != r.orders.end() && order->position.slope) {
       char fit[64];
       if (order->position.r_squared < kGoodFit) {
         std::snprintf(fit, sizeof fit, "no clear order (R\u00b2 %.2f)", order->position.r_squared);
@@ -276,6 +281,9 @@ void analyse_sweep(SweepResult& result) {
       if (o.engine_settings.empty()) o.engine_settings = result.points[i].engine_settings;
     }
     o.position = fit_log_log(dts, pos);
+    o.exact_to_round_off = o.position.points > 0 && std::all_of(pos.begin(), pos.end(), [](std::optional<double> e) {
+      return !e || *e <= kRoundOff;
+    });
     o.energy = fit_log_log(dts, energy);
     result.orders.push_back(std::move(o));
   }
@@ -368,7 +376,9 @@ void print_sweep_table(std::ostream& os, const SweepResult& r) {
       std::string name = series_name(o.engine, o.setting);
       name.resize(name_width, ' ');
       os << "  " << name << "  position " << order_text(o.position);
-      if (o.position.slope) {
+      if (o.exact_to_round_off) {
+        os << " (exact to round-off: every error below 1e-9 m)";
+      } else if (o.position.slope) {
         char buf[48];
         std::snprintf(buf, sizeof buf, " (%d points, R^2 %.3f)", o.position.points, o.position.r_squared);
         os << buf << (o.position.r_squared < kGoodFit ? " no clear order" : "");
@@ -439,7 +449,8 @@ nlohmann::json sweep_to_json(const SweepResult& r) {
     nlohmann::json settings = nlohmann::json::object();
     for (const auto& [key, value] : o.engine_settings) settings[key] = value;
     orders.push_back({{"engine", o.engine}, {"setting", o.setting}, {"position", fit_json(o.position)},
-                      {"energy", fit_json(o.energy)}, {"engine_settings", settings}});
+                      {"energy", fit_json(o.energy)}, {"exact_to_round_off", o.exact_to_round_off},
+                      {"engine_settings", settings}});
   }
   j["orders"] = std::move(orders);
   j["notes"] = r.notes;

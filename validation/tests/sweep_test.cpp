@@ -119,6 +119,17 @@ TEST(SweepAnalysis, OneOrderPerEngineAndSettingInPointOrder) {
   EXPECT_FALSE(r.points.front().pareto);
 }
 
+TEST(SweepAnalysis, RoundOffErrorsAreNotAnOrder) {
+  SweepResult r = synthetic();
+  for (std::size_t i = 0; i < kDts.size(); ++i) r.points[i].position_error = 1e-13 * static_cast<double>(i + 1);
+  analyse_sweep(r);
+  EXPECT_TRUE(r.orders[0].exact_to_round_off);
+  EXPECT_FALSE(r.orders[1].exact_to_round_off);
+  std::ostringstream os;
+  print_sweep_table(os, r);
+  EXPECT_NE(os.str().find("exact to round-off"), std::string::npos);
+}
+
 TEST(SweepAnalysis, ParetoFrontIsThePointsNothingBeats) {
   SweepResult r;
   r.scenario = "front";
