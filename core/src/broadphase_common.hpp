@@ -63,10 +63,11 @@ inline double extent(const Aabb& b) {
 // Cell coordinate of x for cells of edge `cell`, clamped to int32 (clamping is
 // monotone, so neighbours stay neighbours: far-away bodies only cost extra tests).
 inline std::int32_t cell_of(double x, double inv_cell) {
-  const double c = std::floor(x * inv_cell);
-  if (c < -2147483647.0) return -2147483647;
-  if (c > 2147483646.0) return 2147483646;
-  return static_cast<std::int32_t>(c);
+  const double c = x * inv_cell;
+  if (!(c > -2147483647.0)) return -2147483647;   // (also NaN)
+  if (!(c < 2147483646.0)) return 2147483646;
+  const auto i = static_cast<std::int32_t>(c);   // floor without a libm call
+  return c < static_cast<double>(i) ? i - 1 : i;
 }
 
 // Maps cells to buckets by tiling: bucket = (iy mod H) * W + (ix mod W), W and H

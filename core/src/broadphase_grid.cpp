@@ -3,6 +3,11 @@
 // in its own and the eight neighbouring cells. One outlier (a bullet at 10^4 m/s)
 // would make every cell huge, so the cell is capped at 4x the mean box; boxes larger
 // than a cell are "oversize" and tested against every body.
+//
+// The boxes are stored in bucket order (the sort permutes them in place), so a
+// query scans neighbouring cells through contiguous memory. A body's cell is always
+// the cell of its current box's centre; a box grown mid-step whose centre moves gets
+// an extra entry in its new cell, and the entry it leaves behind no longer matches.
 #include "broadphase_common.hpp"
 
 namespace physval {
@@ -10,7 +15,6 @@ namespace physval {
 namespace {
 
 using bp_detail::kNil;
-constexpr std::int32_t kOversize = std::numeric_limits<std::int32_t>::min();
 
 class GridBroadPhase final : public bp_detail::BroadPhaseBase {
  public:
@@ -18,11 +22,19 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
 
   BroadPhaseKind kind() const override { return BroadPhaseKind::Grid; }
 
+  // Filled in body order; build() permutes them into bucket order.
+  std::span<Aabb> prepare(std::size_t n) override {
+    boxes_.resize(n);
+    return boxes_;
+  }
+  const Aabb& box(std::uint32_t i) const override { return boxes_[pos_of_[i]]; }
+
   void build(std::span<const std::uint8_t> active) override {
-    copy_active(active);
     const std::size_t n = boxes_.size();
-    cx_.resize(n);
-    cy_.resize(n);
+    active_.assign(active.begin(), active.end());
+    active_.resize(n, 0);
+    stamp_.assign(n, 0);
+    stamp_value_ = 0;
     oversize_.clear();
 
     double sum = 0.0, largest = 0.0;
@@ -42,36 +54,70 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     cell_ = cell;
     inv_cell_ = 1.0 / cell;
 
+    // Cells of the binned bodies, kept in order_ / pos_of_ for now (kUnbinned: oversize
+    // or inactive; cell_of never returns INT32_MIN).
+    constexpr std::uint32_t kUnbinned = 0x80000000u;
+    pos_of_.resize(n);
+    order_.resize(n);
     std::int32_t x_lo = std::numeric_limits<std::int32_t>::max(), x_hi = std::numeric_limits<std::int32_t>::min();
     std::int32_t y_lo = x_lo, y_hi = x_hi;
     for (std::uint32_t i = 0; i < n; ++i) {
-      if (!active_[i]) continue;
+      if (!active_[i]) {
+        order_[i] = kUnbinned;
+        continue;
+      }
       if (bp_detail::extent(boxes_[i]) > cell_) {
-        cx_[i] = kOversize;
+        order_[i] = kUnbinned;
         oversize_.push_back(i);
         continue;
       }
-      place(i);
-      x_lo = std::min(x_lo, cx_[i]);
-      x_hi = std::max(x_hi, cx_[i]);
-      y_lo = std::min(y_lo, cy_[i]);
-      y_hi = std::max(y_hi, cy_[i]);
+      std::int32_t cx, cy;
+      centre_cell(boxes_[i], cx, cy);
+      order_[i] = static_cast<std::uint32_t>(cx);
+      pos_of_[i] = static_cast<std::uint32_t>(cy);
+      x_lo = std::min(x_lo, cx);
+      x_hi = std::max(x_hi, cx);
+      y_lo = std::min(y_lo, cy);
+      y_hi = std::max(y_hi, cy);
     }
-    const std::int64_t span_x = count > 0 ? static_cast<std::int64_t>(x_hi) - x_lo + 1 : 1;
-    const std::int64_t span_y = count > 0 ? static_cast<std::int64_t>(y_hi) - y_lo + 1 : 1;
-    hash_.choose(count, span_x, span_y);
-
-    // Counting sort of the bodies by bucket.
-    start_.assign(hash_.buckets + 1, 0);
+    const bool any = x_lo <= x_hi;
+    hash_.choose(count, any ? static_cast<std::int64_t>(x_hi) - x_lo + 1 : 1,
+                 any ? static_cast<std::int64_t>(y_hi) - y_lo + 1 : 1);
+    start_.assign(hash_.buckets + 2, 0);
     for (std::uint32_t i = 0; i < n; ++i) {
-      if (active_[i] && cx_[i] != kOversize) ++start_[hash_(cx_[i], cy_[i]) + 1];
+      if (order_[i] == kUnbinned) {
+        pos_of_[i] = kNil;
+        continue;
+      }
+      pos_of_[i] = hash_(static_cast<std::int32_t>(order_[i]), static_cast<std::int32_t>(pos_of_[i]));
+      ++start_[pos_of_[i] + 2];
     }
-    for (std::uint32_t b = 0; b < hash_.buckets; ++b) start_[b + 1] += start_[b];
-    items_.resize(start_[hash_.buckets]);
-    fill_.assign(start_.begin(), start_.end() - 1);
+    // Counting sort: start_[b + 1] becomes the fill cursor of bucket b, then its end.
+    for (std::uint32_t b = 0; b < hash_.buckets; ++b) start_[b + 2] += start_[b + 1];
+    std::uint32_t tail = start_[hash_.buckets + 1];   // unbinned bodies after the buckets
     for (std::uint32_t i = 0; i < n; ++i) {
-      if (active_[i] && cx_[i] != kOversize) items_[fill_[hash_(cx_[i], cy_[i])]++] = i;
+      const std::uint32_t k = pos_of_[i] == kNil ? tail++ : start_[pos_of_[i] + 1]++;
+      order_[k] = i;
+      pos_of_[i] = k;
     }
+    // Boxes into bucket order, in place, following the permutation's cycles (stamp_
+    // marks the positions done).
+    for (std::uint32_t k = 0; k < n; ++k) {
+      if (stamp_[k] != 0) continue;
+      const Aabb first = boxes_[k];
+      std::uint32_t j = k;
+      for (;;) {
+        stamp_[j] = 1;
+        const std::uint32_t src = order_[j];
+        if (src == k) {
+          boxes_[j] = first;
+          break;
+        }
+        boxes_[j] = boxes_[src];
+        j = src;
+      }
+    }
+    std::fill(stamp_.begin(), stamp_.end(), 0u);
     extra_head_.assign(hash_.buckets, kNil);
     extra_next_.clear();
     extra_body_.clear();
@@ -82,12 +128,11 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     for (std::uint32_t b = 0; b < hash_.buckets; ++b) {
       const std::uint32_t end = start_[b + 1];
       for (std::uint32_t k = start_[b]; k < end; ++k) {
-        const std::uint32_t i = items_[k];
-        const std::int32_t cx = cx_[i], cy = cy_[i];
-        const Aabb& a = boxes_[i];
+        const Aabb& a = boxes_[k];
+        std::int32_t cx, cy;
+        centre_cell(a, cx, cy);
         for (std::uint32_t k2 = k + 1; k2 < end; ++k2) {
-          const std::uint32_t j = items_[k2];
-          if (cx_[j] == cx && cy_[j] == cy && overlaps(a, boxes_[j])) push(out, i, j);
+          if (overlaps(a, boxes_[k2]) && in_cell(boxes_[k2], cx, cy)) push(out, order_[k], order_[k2]);
         }
         for (const auto& d : kForward) {
           const std::int64_t nx = static_cast<std::int64_t>(cx) + d[0];
@@ -96,23 +141,25 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
           const auto ncx = static_cast<std::int32_t>(nx), ncy = static_cast<std::int32_t>(ny);
           const std::uint32_t nb = hash_(ncx, ncy);
           for (std::uint32_t k2 = start_[nb]; k2 < start_[nb + 1]; ++k2) {
-            const std::uint32_t j = items_[k2];
-            if (cx_[j] == ncx && cy_[j] == ncy && overlaps(a, boxes_[j])) push(out, i, j);
+            if (overlaps(a, boxes_[k2]) && in_cell(boxes_[k2], ncx, ncy)) push(out, order_[k], order_[k2]);
           }
         }
       }
     }
     for (std::uint32_t o : oversize_) {
-      for (std::uint32_t j = 0; j < boxes_.size(); ++j) {
-        if (!active_[j] || j == o || (cx_[j] == kOversize && j < o)) continue;
-        if (overlaps(boxes_[o], boxes_[j])) push(out, o, j);
+      const Aabb& a = box(o);
+      for (std::uint32_t j = 0; j < active_.size(); ++j) {
+        if (!active_[j] || j == o) continue;
+        const Aabb& bj = box(j);
+        if (bp_detail::extent(bj) > cell_ && j < o) continue;   // that pair is reported from j
+        if (overlaps(a, bj)) push(out, o, j);
       }
     }
   }
 
   void query_box(const Aabb& q, std::uint32_t exclude, std::vector<std::uint32_t>& out) override {
     const std::uint32_t stamp = next_stamp();
-    if (exclude < stamp_.size()) stamp_[exclude] = stamp;
+    if (exclude < pos_of_.size()) stamp_[pos_of_[exclude]] = stamp;
     const double half = 0.5 * cell_;
     const std::int32_t x0 = bp_detail::cell_of(q.min_x - half, inv_cell_);
     const std::int32_t x1 = bp_detail::cell_of(q.max_x + half, inv_cell_);
@@ -121,87 +168,87 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     const double cells = (static_cast<double>(x1) - x0 + 1.0) * (static_cast<double>(y1) - y0 + 1.0);
     if (cells > static_cast<double>(boxes_.size())) {
       // A box wider than the whole scene's cells: test everyone.
-      for (std::uint32_t j = 0; j < boxes_.size(); ++j) {
-        if (active_[j] && first_visit(j, stamp) && overlaps(q, boxes_[j])) out.push_back(j);
+      for (std::uint32_t j = 0; j < active_.size(); ++j) {
+        const std::uint32_t k = pos_of_[j];
+        if (active_[j] && first_visit(k, stamp) && overlaps(q, boxes_[k])) out.push_back(j);
       }
       return;
     }
-    for (std::int32_t y = y0; y <= y1; ++y) {
-      for (std::int32_t x = x0; x <= x1; ++x) {
+    for (std::int32_t y = y0;; ++y) {
+      for (std::int32_t x = x0;; ++x) {
         const std::uint32_t b = hash_(x, y);
-        for (std::uint32_t k = start_[b]; k < start_[b + 1]; ++k) visit(items_[k], x, y, q, stamp, out);
-        for (std::uint32_t e = extra_head_[b]; e != kNil; e = extra_next_[e]) visit(extra_body_[e], x, y, q, stamp, out);
-        if (x == x1) break;   // guard the increment at INT32_MAX
+        for (std::uint32_t k = start_[b]; k < start_[b + 1]; ++k) visit(k, x, y, q, stamp, out);
+        for (std::uint32_t e = extra_head_[b]; e != kNil; e = extra_next_[e]) {
+          visit(pos_of_[extra_body_[e]], x, y, q, stamp, out);
+        }
+        if (x == x1) break;
       }
       if (y == y1) break;
     }
     for (std::uint32_t o : oversize_) {
-      if (first_visit(o, stamp) && overlaps(q, boxes_[o])) out.push_back(o);
+      const std::uint32_t k = pos_of_[o];
+      if (first_visit(k, stamp) && overlaps(q, boxes_[k])) out.push_back(o);
     }
   }
 
   void grow(std::uint32_t i, const Aabb& b) override {
-    if (!active_[i]) {
-      active_[i] = 1;
-      boxes_[i] = b;
-      cx_[i] = kOversize;   // not binned yet
-      cy_[i] = 0;
-      if (bp_detail::extent(b) > cell_) {
-        oversize_.push_back(i);
-        return;
-      }
-      place(i);
-      add_extra(i);
-      return;
-    }
-    boxes_[i] = merge(boxes_[i], b);
-    if (cx_[i] == kOversize) return;
-    if (bp_detail::extent(boxes_[i]) > cell_) {
-      cx_[i] = kOversize;
+    const std::uint32_t k = pos_of_[i];
+    const bool was_active = active_[i] != 0;
+    const bool was_oversize = was_active && bp_detail::extent(boxes_[k]) > cell_;
+    std::int32_t ox = 0, oy = 0;
+    if (was_active) centre_cell(boxes_[k], ox, oy);
+    boxes_[k] = was_active ? merge(boxes_[k], b) : b;
+    active_[i] = 1;
+    if (was_oversize) return;
+    if (bp_detail::extent(boxes_[k]) > cell_) {
       oversize_.push_back(i);
       return;
     }
-    const std::int32_t ox = cx_[i], oy = cy_[i];
-    place(i);
-    if (cx_[i] != ox || cy_[i] != oy) add_extra(i);
+    std::int32_t cx, cy;
+    centre_cell(boxes_[k], cx, cy);
+    if (was_active && cx == ox && cy == oy) return;
+    const std::uint32_t bucket = hash_(cx, cy);
+    extra_body_.push_back(i);
+    extra_next_.push_back(extra_head_[bucket]);
+    extra_head_[bucket] = static_cast<std::uint32_t>(extra_body_.size() - 1);
   }
 
   std::size_t memory_bytes() const override {
-    return base_bytes() + (cx_.capacity() + cy_.capacity()) * sizeof(std::int32_t) +
-           (start_.capacity() + fill_.capacity() + items_.capacity() + oversize_.capacity() +
-            extra_head_.capacity() + extra_next_.capacity() + extra_body_.capacity()) *
-               sizeof(std::uint32_t);
+    return base_bytes() + (start_.capacity() + order_.capacity() + pos_of_.capacity() + oversize_.capacity() +
+                           extra_head_.capacity() + extra_next_.capacity() + extra_body_.capacity()) *
+                              sizeof(std::uint32_t);
   }
 
  private:
   static void push(std::vector<BodyPair>& out, std::uint32_t i, std::uint32_t j) {
     out.push_back(i < j ? BodyPair{i, j} : BodyPair{j, i});
   }
-  void place(std::uint32_t i) {
-    const Aabb& b = boxes_[i];
-    cx_[i] = bp_detail::cell_of(0.5 * (static_cast<double>(b.min_x) + b.max_x), inv_cell_);
-    cy_[i] = bp_detail::cell_of(0.5 * (static_cast<double>(b.min_y) + b.max_y), inv_cell_);
+  void centre_cell(const Aabb& b, std::int32_t& cx, std::int32_t& cy) const {
+    cx = bp_detail::cell_of(0.5 * (static_cast<double>(b.min_x) + b.max_x), inv_cell_);
+    cy = bp_detail::cell_of(0.5 * (static_cast<double>(b.min_y) + b.max_y), inv_cell_);
   }
-  void add_extra(std::uint32_t i) {
-    const std::uint32_t b = hash_(cx_[i], cy_[i]);
-    extra_body_.push_back(i);
-    extra_next_.push_back(extra_head_[b]);
-    extra_head_[b] = static_cast<std::uint32_t>(extra_body_.size() - 1);
+  bool in_cell(const Aabb& b, std::int32_t x, std::int32_t y) const {
+    std::int32_t cx, cy;
+    centre_cell(b, cx, cy);
+    return cx == x && cy == y;
   }
-  void visit(std::uint32_t j, std::int32_t x, std::int32_t y, const Aabb& q, std::uint32_t stamp,
+  void visit(std::uint32_t k, std::int32_t x, std::int32_t y, const Aabb& q, std::uint32_t stamp,
              std::vector<std::uint32_t>& out) {
-    // A body's current cell is the one that counts: entries left behind by grow() and
-    // bucket collisions are filtered here.
-    if (cx_[j] != x || cy_[j] != y) return;
-    if (first_visit(j, stamp) && overlaps(q, boxes_[j])) out.push_back(j);
+    // Only a box whose centre is in this cell counts here: entries left behind by
+    // grow(), other cells sharing the bucket and oversize boxes are skipped.
+    const Aabb& bk = boxes_[k];
+    if (!overlaps(q, bk) || bp_detail::extent(bk) > cell_ || !in_cell(bk, x, y)) return;
+    if (first_visit(k, stamp)) out.push_back(order_[k]);
   }
 
   double option_cell_ = 0.0;
   double cell_ = 1.0;
   double inv_cell_ = 1.0;
   bp_detail::TileHash hash_;
-  std::vector<std::int32_t> cx_, cy_;
-  std::vector<std::uint32_t> start_, fill_, items_, oversize_;
+  std::vector<std::uint32_t> start_;    // bucket b holds positions [start_[b], start_[b + 1])
+  std::vector<std::uint32_t> order_;    // body at each position
+  std::vector<std::uint32_t> pos_of_;   // position of each body (its box is boxes_[pos])
+  std::vector<std::uint32_t> oversize_;
   std::vector<std::uint32_t> extra_head_, extra_next_, extra_body_;
 };
 

@@ -13,8 +13,9 @@ namespace {
 constexpr std::size_t kBruteForceLimit = 8;
 
 std::int32_t cell_of(double x, double inv) {
-  const double c = std::floor(x * inv);
-  return static_cast<std::int32_t>(std::clamp(c, -2147483647.0, 2147483646.0));
+  const double c = std::clamp(x * inv, -2147483647.0, 2147483646.0);
+  const auto i = static_cast<std::int32_t>(c);   // floor without a libm call
+  return c < static_cast<double>(i) ? i - 1 : i;
 }
 
 std::uint32_t bucket(std::int32_t x, std::int32_t y, std::uint32_t mask) {
