@@ -572,7 +572,7 @@ std::vector<Setting> BulletEngine::settings() const {
        "removeRigidBody after the step"},
       {"contact_events", "dispatcher manifolds scanned after each step, once per physval pair, at the end of the step"},
       {"contact_breaking_threshold", fmt(static_cast<double>(gContactBreakingThreshold)) +
-                                         " x the shape's size (Bullet's default, relative)"},
+                                         " x the shape's angular motion disc, sqrt(3) r for a sphere (Bullet's default)"},
   };
 }
 
