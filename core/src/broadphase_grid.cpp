@@ -5,9 +5,11 @@
 // than a cell are "oversize" and tested against every body.
 //
 // The boxes are stored in bucket order (the sort permutes them in place), so a
-// query scans neighbouring cells through contiguous memory. A body's cell is always
-// the cell of its current box's centre; a box grown mid-step whose centre moves gets
-// an extra entry in its new cell, and the entry it leaves behind no longer matches.
+// query scans neighbouring cells through contiguous memory. Each body has a home
+// cell, that of its box centre at the build. A box grown mid-step keeps its home while
+// its centre stays within a quarter cell of it (queries look that much further);
+// beyond, it moves home to its new centre's cell through an extra entry, and the
+// entry it leaves behind no longer matches.
 #include "broadphase_common.hpp"
 
 namespace physval {
@@ -118,6 +120,9 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
       }
     }
     std::fill(stamp_.begin(), stamp_.end(), 0u);
+    home_x_.resize(n);
+    home_y_.resize(n);
+    for (std::uint32_t k = 0; k < n; ++k) centre_cell(boxes_[k], home_x_[k], home_y_[k]);
     extra_head_.assign(hash_.buckets, kNil);
     extra_next_.clear();
     extra_body_.clear();
@@ -129,10 +134,9 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
       const std::uint32_t end = start_[b + 1];
       for (std::uint32_t k = start_[b]; k < end; ++k) {
         const Aabb& a = boxes_[k];
-        std::int32_t cx, cy;
-        centre_cell(a, cx, cy);
+        const std::int32_t cx = home_x_[k], cy = home_y_[k];
         for (std::uint32_t k2 = k + 1; k2 < end; ++k2) {
-          if (overlaps(a, boxes_[k2]) && in_cell(boxes_[k2], cx, cy)) push(out, order_[k], order_[k2]);
+          if (overlaps(a, boxes_[k2]) && home_x_[k2] == cx && home_y_[k2] == cy) push(out, order_[k], order_[k2]);
         }
         for (const auto& d : kForward) {
           const std::int64_t nx = static_cast<std::int64_t>(cx) + d[0];
@@ -141,7 +145,7 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
           const auto ncx = static_cast<std::int32_t>(nx), ncy = static_cast<std::int32_t>(ny);
           const std::uint32_t nb = hash_(ncx, ncy);
           for (std::uint32_t k2 = start_[nb]; k2 < start_[nb + 1]; ++k2) {
-            if (overlaps(a, boxes_[k2]) && in_cell(boxes_[k2], ncx, ncy)) push(out, order_[k], order_[k2]);
+            if (overlaps(a, boxes_[k2]) && home_x_[k2] == ncx && home_y_[k2] == ncy) push(out, order_[k], order_[k2]);
           }
         }
       }
@@ -160,7 +164,7 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
   void query_box(const Aabb& q, std::uint32_t exclude, std::vector<std::uint32_t>& out) override {
     const std::uint32_t stamp = next_stamp();
     if (exclude < pos_of_.size()) stamp_[pos_of_[exclude]] = stamp;
-    const double half = 0.5 * cell_;
+    const double half = 0.75 * cell_;   // half a cell, and the quarter a home may drift
     const std::int32_t x0 = bp_detail::cell_of(q.min_x - half, inv_cell_);
     const std::int32_t x1 = bp_detail::cell_of(q.max_x + half, inv_cell_);
     const std::int32_t y0 = bp_detail::cell_of(q.min_y - half, inv_cell_);
@@ -195,8 +199,6 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     const std::uint32_t k = pos_of_[i];
     const bool was_active = active_[i] != 0;
     const bool was_oversize = was_active && bp_detail::extent(boxes_[k]) > cell_;
-    std::int32_t ox = 0, oy = 0;
-    if (was_active) centre_cell(boxes_[k], ox, oy);
     boxes_[k] = was_active ? merge(boxes_[k], b) : b;
     active_[i] = 1;
     if (was_oversize) return;
@@ -204,17 +206,17 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
       oversize_.push_back(i);
       return;
     }
-    std::int32_t cx, cy;
-    centre_cell(boxes_[k], cx, cy);
-    if (was_active && cx == ox && cy == oy) return;
-    const std::uint32_t bucket = hash_(cx, cy);
+    if (was_active && near_home(k)) return;
+    centre_cell(boxes_[k], home_x_[k], home_y_[k]);
+    const std::uint32_t bucket = hash_(home_x_[k], home_y_[k]);
     extra_body_.push_back(i);
     extra_next_.push_back(extra_head_[bucket]);
     extra_head_[bucket] = static_cast<std::uint32_t>(extra_body_.size() - 1);
   }
 
   std::size_t memory_bytes() const override {
-    return base_bytes() + (start_.capacity() + order_.capacity() + pos_of_.capacity() + oversize_.capacity() +
+    return base_bytes() + (home_x_.capacity() + home_y_.capacity()) * sizeof(std::int32_t) +
+           (start_.capacity() + order_.capacity() + pos_of_.capacity() + oversize_.capacity() +
                            extra_head_.capacity() + extra_next_.capacity() + extra_body_.capacity()) *
                               sizeof(std::uint32_t);
   }
@@ -227,17 +229,23 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     cx = bp_detail::cell_of(0.5 * (static_cast<double>(b.min_x) + b.max_x), inv_cell_);
     cy = bp_detail::cell_of(0.5 * (static_cast<double>(b.min_y) + b.max_y), inv_cell_);
   }
-  bool in_cell(const Aabb& b, std::int32_t x, std::int32_t y) const {
-    std::int32_t cx, cy;
-    centre_cell(b, cx, cy);
-    return cx == x && cy == y;
+  // The centre of the box at position k is within a quarter cell of its home cell.
+  bool near_home(std::uint32_t k) const {
+    const Aabb& b = boxes_[k];
+    const double cx = 0.5 * (static_cast<double>(b.min_x) + b.max_x);
+    const double cy = 0.5 * (static_cast<double>(b.min_y) + b.max_y);
+    const double q = 0.25 * cell_;
+    // Strictly below the upper bound, as a centre binned by floor() is: queries rely on it.
+    return cx >= home_x_[k] * cell_ - q && cx < (home_x_[k] + 1.0) * cell_ + q && cy >= home_y_[k] * cell_ - q &&
+           cy < (home_y_[k] + 1.0) * cell_ + q;
   }
   void visit(std::uint32_t k, std::int32_t x, std::int32_t y, const Aabb& q, std::uint32_t stamp,
              std::vector<std::uint32_t>& out) {
-    // Only a box whose centre is in this cell counts here: entries left behind by
-    // grow(), other cells sharing the bucket and oversize boxes are skipped.
+    // Only the body's entry in its home cell counts: entries left behind by grow(),
+    // other cells sharing the bucket and oversize boxes are skipped.
+    if (home_x_[k] != x || home_y_[k] != y) return;
     const Aabb& bk = boxes_[k];
-    if (!overlaps(q, bk) || bp_detail::extent(bk) > cell_ || !in_cell(bk, x, y)) return;
+    if (!overlaps(q, bk) || bp_detail::extent(bk) > cell_) return;
     if (first_visit(k, stamp)) out.push_back(order_[k]);
   }
 
@@ -249,6 +257,7 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
   std::vector<std::uint32_t> order_;    // body at each position
   std::vector<std::uint32_t> pos_of_;   // position of each body (its box is boxes_[pos])
   std::vector<std::uint32_t> oversize_;
+  std::vector<std::int32_t> home_x_, home_y_;   // home cell of the body at each position
   std::vector<std::uint32_t> extra_head_, extra_next_, extra_body_;
 };
 
