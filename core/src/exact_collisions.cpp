@@ -53,14 +53,53 @@ Aabb path_box(const World& w, std::uint32_t i, double t, double T) {
 
 namespace {
 
+// The queue's order: time, then kind (so simultaneous events resolve in a fixed
+// order), then bodies; total, so runs are bit-identical.
 bool later(const Event& x, const Event& y) {
   if (x.time != y.time) return x.time > y.time;
-  if (x.kind != y.kind) return x.kind > y.kind;
+  const std::uint32_t kx = x.tag >> 28, ky = y.tag >> 28;   // kind and feature
+  if ((kx >> 1) != (ky >> 1)) return (kx >> 1) > (ky >> 1);
   if (x.a != y.a) return x.a > y.a;
   if (x.b != y.b) return x.b > y.b;
-  if (x.feature != y.feature) return x.feature > y.feature;
+  if (kx != ky) return kx > ky;
   if (x.va != y.va) return x.va > y.va;
-  return x.vb > y.vb;
+  return x.tag > y.tag;
+}
+
+// A 4-ary min-heap: half the levels of a binary heap, four children in two cache lines.
+void heap_push(std::vector<Event>& h, const Event& e) {
+  std::size_t i = h.size();
+  h.push_back(e);
+  while (i > 0) {
+    const std::size_t parent = (i - 1) / 4;
+    if (!later(h[parent], e)) break;
+    h[i] = h[parent];
+    i = parent;
+  }
+  h[i] = e;
+}
+
+Event heap_pop(std::vector<Event>& h) {
+  const Event top = h.front();
+  const Event last = h.back();
+  h.pop_back();
+  const std::size_t n = h.size();
+  if (n == 0) return top;
+  std::size_t i = 0;
+  for (;;) {
+    const std::size_t first = 4 * i + 1;
+    if (first >= n) break;
+    std::size_t best = first;
+    const std::size_t end = std::min(first + 4, n);
+    for (std::size_t c = first + 1; c < end; ++c) {
+      if (later(h[best], h[c])) best = c;
+    }
+    if (!later(last, h[best])) break;
+    h[i] = h[best];
+    i = best;
+  }
+  h[i] = last;
+  return top;
 }
 
 double inf_norm(Vec2 v) { return std::max(std::fabs(v.x), std::fabs(v.y)); }
@@ -90,14 +129,13 @@ class EventLoop {
       schedule_body(i, 0.0);
     }
     if (!w_.emitters.empty()) {
-      schedule_explosions(w_, ctx_, w_.heap);
-      std::make_heap(w_.heap.begin(), w_.heap.end(), later);
+      w_.scratch_events.clear();
+      schedule_explosions(w_, ctx_, w_.scratch_events);
+      for (const Event& e : w_.scratch_events) heap_push(w_.heap, e);
     }
 
     while (!w_.heap.empty()) {
-      std::pop_heap(w_.heap.begin(), w_.heap.end(), later);
-      const Event e = w_.heap.back();
-      w_.heap.pop_back();
+      const Event e = heap_pop(w_.heap);
       if (!valid(e)) continue;
       if (ctx_.events >= ctx_.event_cap) {
         finish_with_lecture_pass(e.time);
@@ -109,15 +147,13 @@ class EventLoop {
   }
 
  private:
-  void push(const Event& e) {
-    w_.heap.push_back(e);
-    std::push_heap(w_.heap.begin(), w_.heap.end(), later);
-  }
+  void push(const Event& e) { heap_push(w_.heap, e); }
 
   bool valid(const Event& e) const {
     if (!w_.alive(e.a)) return false;
-    switch (e.kind) {
-      case EventKind::Pair: return w_.alive(e.b) && w_.version[e.a] == e.va && w_.version[e.b] == e.vb;
+    switch (e.kind()) {
+      case EventKind::Pair:
+        return w_.alive(e.b) && w_.version[e.a] == e.va && (w_.version[e.b] & Event::kVersionMask) == e.vb();
       case EventKind::Static:
       case EventKind::Stop:
       case EventKind::Leave: return w_.version[e.a] == e.va;
@@ -157,7 +193,7 @@ class EventLoop {
     const double speed = length(dv) + length(da) * (T_ - t);
     const double s = toi::circle_circle(pj - pi, dv, da, R, T_ - t, toi::squared_tolerance(scale, speed, R));
     if (s == toi::kNever) return;
-    push({t + s, i, j, w_.version[i], w_.version[j], EventKind::Pair, 0});
+    push(Event::make(t + s, i, j, w_.version[i], w_.version[j], EventKind::Pair));
   }
 
   void schedule_statics(std::uint32_t i, double t, const Aabb& box) {
@@ -176,21 +212,21 @@ class EventLoop {
       const toi::SegmentHit hit =
           toi::circle_segment(p, v, a, w_.radius[i], seg.from, seg.to, T_ - t, w_.length_scale);
       if (hit.s == toi::kNever) continue;
-      push({t + hit.s, i, k, w_.version[i], 0, EventKind::Static, static_cast<std::uint8_t>(hit.cap ? 1 : 0)});
+      push(Event::make(t + hit.s, i, k, w_.version[i], 0, EventKind::Static, hit.cap ? 1 : 0));
     }
   }
 
   void schedule_body(std::uint32_t i, double t) {
     if (w_.supported(i)) {
       const double stop = support_stop_time(w_, i, t, T_);
-      if (stop != toi::kNever) push({stop, i, 0, w_.version[i], 0, EventKind::Stop, 0});
+      if (stop != toi::kNever) push(Event::make(stop, i, 0, w_.version[i], 0, EventKind::Stop));
       const double leave = support_leave_time(w_, i, t, T_);
-      if (leave != toi::kNever) push({leave, i, 0, w_.version[i], 0, EventKind::Leave, 0});
+      if (leave != toi::kNever) push(Event::make(leave, i, 0, w_.version[i], 0, EventKind::Leave));
     }
     if (w_.flags[i] & kParticle) {
       const std::size_t k = i - w_.scene_bodies;
       const double death = w_.birth[k] + w_.lifetime[k] - ctx_.t0;
-      if (death <= T_) push({std::max(death, t), i, 0, w_.version[i], 0, EventKind::Expire, 0});
+      if (death <= T_) push(Event::make(std::max(death, t), i, 0, w_.version[i], 0, EventKind::Expire));
     }
   }
 
@@ -250,9 +286,9 @@ class EventLoop {
 
   void process(const Event& e) {
     const double t_abs = ctx_.t0 + e.time;
-    switch (e.kind) {
+    switch (e.kind()) {
       case EventKind::Pair: process_pair(e.a, e.b, e.time, t_abs); break;
-      case EventKind::Static: process_static(e.a, e.b, e.feature, e.time, t_abs); break;
+      case EventKind::Static: process_static(e.a, e.b, e.feature(), e.time, t_abs); break;
       case EventKind::Stop:
         w_.advance(e.a, e.time);
         w_.vel[e.a] = {};

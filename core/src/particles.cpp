@@ -72,7 +72,7 @@ void schedule_explosions(World& w, const StepContext& ctx, std::vector<Event>& o
     if (e.def.mode != EmitterMode::Explode || e.exploded || !w.alive(e.parent)) continue;
     const double at = e.def.at - ctx.t0;
     if (at > ctx.dt) continue;
-    out.push_back({std::max(at, 0.0), e.parent, static_cast<std::uint32_t>(k), 0, 0, EventKind::Explode, 0});
+    out.push_back(Event::make(std::max(at, 0.0), e.parent, static_cast<std::uint32_t>(k), 0, 0, EventKind::Explode));
   }
 }
 
