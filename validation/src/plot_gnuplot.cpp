@@ -117,7 +117,8 @@ std::string axis_commands(char name, const Axis& axis, const Extent& data, bool 
     log_step = decades > 16.0 ? 10000.0 : (decades > 8.0 ? 100.0 : 0.0);
     os << "set m" << a << "tics " << (log_step > 0.0 ? "default" : "10") << "\n";
   } else {
-    os << "unset logscale " << a << "\nset format " << a << " \"%g\"\nset m" << a << "tics default\n";
+    // Enough digits for an axis over a narrow band (a conserved quantity's wobble).
+    os << "unset logscale " << a << "\nset format " << a << " \"%.10g\"\nset m" << a << "tics default\n";
   }
   if (!axis.tics.empty()) {
     os << "set " << a << "tics (";
@@ -187,6 +188,10 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
     os << "\n";
   }
 
+  const bool aligned = multi && figure.columns <= 1;
+  const bool keys_outside = std::any_of(figure.panels.begin(), figure.panels.end(), [](const Panel& p) {
+    return p.key.find("outside") != std::string::npos;
+  });
   std::size_t block = 0;   // index of the next data block in the data file
   for (const Panel& panel : figure.panels) {
     // Automatic colours and markers restart in each panel: series i looks the same
@@ -219,6 +224,13 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
       os << "set key off\n";
     } else {
       os << "set key default\nset key " << panel.key << " box opaque samplen 3 spacing 1.15 font ',10' noenhanced\n";
+    }
+    // Stacked panels with legends beside them share their left and right edges, so
+    // their time axes line up.
+    if (aligned) {
+      os << "set lmargin at screen 0.11\nset rmargin at screen " << (keys_outside ? "0.74" : "0.96") << "\n";
+    } else {
+      os << "unset lmargin\nunset rmargin\n";
     }
     os << (panel.equal_aspect ? "set size ratio -1\n" : "set size noratio\n");
     for (std::size_t i = 0; i < panel.labels.size(); ++i) {

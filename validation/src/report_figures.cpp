@@ -130,7 +130,7 @@ plot::Series curve(const Source& s, const std::vector<std::string>& engines, con
 std::string reference_label(const json* ref) {
   std::string label = "reference";
   if (ref != nullptr) {
-    if (auto dt = num(*ref, "dt"); dt && *dt > 0.0) label += " (core, dt " + fmt(*dt) + " s)";
+    if (auto dt = num(*ref, "dt"); dt && *dt > 0.0) label += " (dt " + fmt(*dt) + " s)";
   }
   return label;
 }
@@ -159,6 +159,8 @@ plot::Figure energy_figure(const ScenarioView& v, const std::vector<std::string>
     for (std::size_t i = 0; i < e->size(); ++i) d[i] = std::abs((*e)[i] - e->front());
     error.series.push_back(curve(s, engines, *t, d));
   }
+  total.key = "off";
+  error.key = "below center horizontal Left reverse";
   fig.panels = {total, error};
   return fig;
 }
@@ -187,6 +189,10 @@ plot::Figure momentum_figure(const ScenarioView& v, const std::vector<std::strin
       if (t != nullptr && y != nullptr) p.series.push_back(curve(s, engines, *t, *y));
     }
     fig.panels.push_back(std::move(p));
+  }
+  // One legend, under the last panel: the same engines are in every panel.
+  for (std::size_t i = 0; i < fig.panels.size(); ++i) {
+    fig.panels[i].key = i + 1 == fig.panels.size() ? "below center horizontal Left reverse" : "off";
   }
   return fig;
 }
@@ -423,6 +429,47 @@ std::optional<plot::Figure> contact_figure(const ScenarioView& v, const std::vec
   }
   for (plot::Series& s : by_pair) p.series.push_back(std::move(s));
   fig.panels.push_back(std::move(p));
+
+  // How early or late each engine's contacts are: the n-th contact of a pair against
+  // the reference's n-th contact of the same pair (the whole-run timeline hides
+  // a step's lateness).
+  if (!rows.empty() && rows.front().label == "reference" && !rows.front().contacts.empty() && rows.size() > 1) {
+    std::map<std::string, std::vector<double>> reference_times;
+    for (const ContactPoint& c : rows.front().contacts) reference_times[c.pair].push_back(c.time);
+    plot::Panel e;
+    e.title = "contact time minus the reference's (n-th contact of a pair against its n-th)";
+    e.x.label = "reference contact time (s)";
+    e.y.label = "time error (ms)";
+    e.key = "outside right top";
+    if (v.duration > 0.0) {
+      e.x.min = 0.0;
+      e.x.max = v.duration;
+    }
+    bool any = false;
+    for (std::size_t r = 1; r < rows.size(); ++r) {
+      plot::Series sr;
+      sr.title = rows[r].label;
+      sr.style = plot::Style::Points;
+      sr.point_size = 1.5;
+      const Look l = look_of(engines, rows[r].label);
+      sr.color = l.colour;
+      sr.point_type = std::vector<int>{7, 5, 9, 13, 11}[static_cast<std::size_t>(l.colour) % 5];
+      std::map<std::string, std::size_t> seen;
+      for (const ContactPoint& c : rows[r].contacts) {
+        const std::size_t nth = seen[c.pair]++;
+        const auto it = reference_times.find(c.pair);
+        if (it == reference_times.end() || nth >= it->second.size()) continue;
+        sr.x.push_back(it->second[nth]);
+        sr.y.push_back(1000.0 * (c.time - it->second[nth]));
+        any = true;
+      }
+      e.series.push_back(std::move(sr));
+    }
+    if (any) {
+      fig.height += 330;
+      fig.panels.push_back(std::move(e));
+    }
+  }
   return fig;
 }
 
