@@ -228,7 +228,7 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
     // Stacked panels with legends beside them share their left and right edges, so
     // their time axes line up.
     if (aligned) {
-      os << "set lmargin at screen 0.11\nset rmargin at screen " << (keys_outside ? "0.74" : "0.96") << "\n";
+      os << "set lmargin at screen 0.14\nset rmargin at screen " << (keys_outside ? "0.74" : "0.96") << "\n";
     } else {
       os << "unset lmargin\nunset rmargin\n";
     }
@@ -241,11 +241,25 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
     }
 
     std::vector<std::string> parts;
+    const std::size_t first_block = block;
     for (std::size_t i = 0; i < panel.series.size(); ++i) {
       const Series& s = panel.series[i];
       const int colour = s.color >= 0 ? s.color : auto_colour++;
       const int pt = s.point_type >= 0 ? s.point_type : kPointTypes[auto_point++ % kPointTypeCount];
-      if (data[i].empty()) continue;   // nothing drawable: leave it out of the plot
+      if (data[i].empty()) {
+        // Nothing drawable (all zero on a log axis, or unmeasured): still in the legend,
+        // saying so, so a reader does not look for a line that is not there.
+        if (!s.title.empty()) {
+          std::ostringstream k;
+          k << "keyentry with " << style_of(s) << " lc rgb '"
+            << (s.rgb.empty() ? palette()[static_cast<std::size_t>(colour) % palette().size()] : s.rgb) << "' lw "
+            << number(s.line_width) << " dt " << s.dash;
+          if (s.style != Style::Lines) k << " pt " << pt << " ps " << number(s.point_size);
+          k << " title " << gp_string(s.title + " (nothing to draw)") << " noenhanced";
+          parts.push_back(k.str());
+        }
+        continue;
+      }
       std::ostringstream p;
       p << gp_string(data_file.string()) << " index " << block << " using 1:2 with " << style_of(s)
         << " lc rgb '"
@@ -261,7 +275,7 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
       parts.push_back(p.str());
       ++block;
     }
-    if (parts.empty()) {
+    if (block == first_block) {   // not one drawable series
       // An empty panel still renders (and says so) rather than failing the figure.
       os << "unset logscale xy\nset format x \"%g\"\nset format y \"%g\"\n"
          << "set xtics auto norotate\nset ytics auto norotate\nset mxtics default\nset mytics default\n"

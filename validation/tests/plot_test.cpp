@@ -130,7 +130,7 @@ TEST(Plot, SurvivesZerosNaNsEmptySeriesAndQuotes) {
   fs::remove_all(dir);
 }
 
-TEST(Plot, ScriptLeavesOutSeriesWithNothingToDraw) {
+TEST(Plot, SeriesWithNothingToDrawStayInTheLegendOnly) {
   Figure fig;
   Panel p;
   p.y.log = true;
@@ -141,7 +141,11 @@ TEST(Plot, ScriptLeavesOutSeriesWithNothingToDraw) {
   p.series = {zero, line("drawable", 2.0)};
   fig.panels.push_back(p);
   const std::string script = gnuplot_script(fig, "data.txt", "out.png");
-  EXPECT_EQ(script.find("all zero"), std::string::npos);
+  // In the legend only (keyentry), never as a data block: one `index` for one series.
+  EXPECT_NE(script.find("keyentry"), std::string::npos);
+  EXPECT_NE(script.find("all zero (nothing to draw)"), std::string::npos);
+  EXPECT_NE(script.find("index 0"), std::string::npos);
+  EXPECT_EQ(script.find("index 1"), std::string::npos);
   EXPECT_NE(script.find("drawable"), std::string::npos);
   EXPECT_NE(script.find("set logscale y"), std::string::npos);
 }
