@@ -345,7 +345,7 @@ void print_sweep_table(std::ostream& os, const SweepResult& r) {
     }
     std::string status = run_status_name(p.status);
     if (!p.reason.empty()) status += ": " + p.reason;
-    rows.push_back({p.engine, p.setting.empty() ? "-" : p.setting, dt_label(p.dt), std::to_string(p.steps),
+    rows.push_back({p.engine, p.setting.empty() ? "-" : display_setting(p.setting), dt_label(p.dt), std::to_string(p.steps),
                     timed ? sci(p.wall_per_sim_median) : "-", spread, sci(p.position_error), sci(p.energy_error),
                     sci(p.contact_time_error), p.pareto ? "*" : "", status});
   }
@@ -371,9 +371,9 @@ void print_sweep_table(std::ostream& os, const SweepResult& r) {
   if (!r.orders.empty()) {
     os << "\nobserved order of convergence (least-squares slope of log error against log dt):\n";
     std::size_t name_width = 0;
-    for (const ConvergenceOrder& o : r.orders) name_width = std::max(name_width, series_name(o.engine, o.setting).size());
+    for (const ConvergenceOrder& o : r.orders) name_width = std::max(name_width, legend_name(o.engine, o.setting).size());
     for (const ConvergenceOrder& o : r.orders) {
-      std::string name = series_name(o.engine, o.setting);
+      std::string name = legend_name(o.engine, o.setting);
       name.resize(name_width, ' ');
       os << "  " << name << "  position " << order_text(o.position);
       if (o.exact_to_round_off) {

@@ -166,7 +166,7 @@ TEST(SweepTable, HasItsColumnsOneRowPerPointAndTheOrders) {
   // The orders section names each series with its slope.
   bool alpha_order = false, beta_order = false;
   for (const std::string& line : lines) {
-    if (line.find("alpha integrator=rk4") != std::string::npos && line.find("position 2.00") != std::string::npos) alpha_order = true;
+    if (line.find("alpha rk4") != std::string::npos && line.find("position 2.00") != std::string::npos) alpha_order = true;
     if (line.find("  beta") == 0 && line.find("position 1.00") != std::string::npos) beta_order = true;
   }
   EXPECT_TRUE(alpha_order) << os.str();
@@ -209,6 +209,7 @@ TEST(SweepCsv, HeaderAndOneLinePerPointWithEmptyNulls) {
   EXPECT_EQ(fields(lines[1])[col("energy_error")], "");
   EXPECT_NEAR(std::stod(fields(lines[1])[col("position_error")]), *r.points[0].position_error, 1e-12);
   EXPECT_EQ(fields(lines[1])[col("dt_label")], "1/30");
+  EXPECT_EQ(fields(lines[1])[col("setting")], "integrator=rk4");   // full label, not the short one
 }
 
 TEST(SweepJson, PointsOrdersAndNulls) {

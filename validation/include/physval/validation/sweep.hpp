@@ -116,6 +116,8 @@ void analyse_sweep(SweepResult& result);
 std::string dt_label(double dt);
 
 // The table on the terminal: one row per point, then the orders of convergence.
+// Settings show in short form ("rk4, exact"; "4 velocity + 3 position iterations");
+// the CSV and JSON keep the full "key=value" labels.
 void print_sweep_table(std::ostream& os, const SweepResult& result);
 
 std::string sweep_to_csv(const SweepResult& result);
