@@ -271,6 +271,10 @@ class EventLoop {
   // its support is released; otherwise its friction is re-evaluated.
   void after_velocity_change(std::uint32_t i) {
     if (!w_.supported(i)) return;
+    if (w_.on_body(i)) {   // held still on a body: any velocity frees it
+      if (w_.vel[i].x != 0.0 || w_.vel[i].y != 0.0) release_support(w_, i);
+      return;
+    }
     const double vn = dot(w_.vel[i], w_.support_n[i]);
     const double tol = 1e-12 * (length(w_.vel[i]) + 1e-300);
     if (std::fabs(vn) > tol) {
@@ -278,6 +282,19 @@ class EventLoop {
     } else {
       support_path(w_, i);
     }
+  }
+
+  // Body x's path changed at time t: whatever rested on it (and on those) is free.
+  void free_dependents(std::uint32_t x, double t) {
+    if (w_.dep_head.empty() || w_.dep_head[x] == kNone) return;
+    w_.released.clear();
+    collect_dependents(w_, x);
+    for (std::uint32_t d : w_.released) {
+      w_.advance(d, t);
+      release_support(w_, d);
+      ++w_.version[d];
+    }
+    for (std::uint32_t d : w_.released) reschedule(d, t);
   }
 
   void destroy_after(std::uint32_t i, bool by_rule) {
@@ -301,14 +318,17 @@ class EventLoop {
         release_support(w_, e.a);
         ++w_.version[e.a];
         reschedule(e.a, e.time);
+        free_dependents(e.a, e.time);
         break;
       case EventKind::Expire:
         w_.advance(e.a, e.time);
         kill_body(w_, e.a);
+        free_dependents(e.a, e.time);
         break;
       case EventKind::Explode:
         w_.advance(e.a, e.time);
         explode_parent(w_, e.b, t_abs);
+        free_dependents(e.a, e.time);
         break;
     }
   }
@@ -328,25 +348,43 @@ class EventLoop {
     const Vec2 n = dl > 0.0 ? d / dl : Vec2{1.0, 0.0};
     const PairMaterial m = w_.pair_material(w_.material[i], w_.material[j]);
     double min_sep = 0.0;
+    bool settled = false;
     if (w_.any_forces) {
-      // Pressed together (relative acceleration closing) and too slow to bounce clear:
-      // a micro-bounce with a flight of at least ~1/8 step instead of endless impacts.
       const double an = dot(w_.effective_acc(j) - w_.effective_acc(i), n);
       const double vn = dot(w_.vel[j] - w_.vel[i], n);
       if (an < 0.0) {
         const double vr = w_.rest_speed(an, ctx_.dt);
-        if (m.restitution * std::max(0.0, -vn) < vr) min_sep = 0.5 * vr;
+        if (m.restitution * std::max(0.0, -vn) < vr) {
+          // Pressed together and too slow to bounce clear. Onto a body at rest: come to
+          // rest on it (a stack). Otherwise a micro-bounce with a flight of at least
+          // ~1/8 step instead of endless impacts.
+          if (can_rest_on(w_, i, j, -n, vr)) {
+            rest_on_body(w_, i, j, -n);
+            settled = true;
+          } else if (can_rest_on(w_, j, i, n, vr)) {
+            rest_on_body(w_, j, i, n);
+            settled = true;
+          } else {
+            min_sep = 0.5 * vr;
+          }
+        }
       }
     }
-    resolve_pair(w_, i, j, n, m, min_sep);
-    after_velocity_change(i);
-    after_velocity_change(j);
+    if (!settled) {
+      resolve_pair(w_, i, j, n, m, min_sep);
+      after_velocity_change(i);
+      after_velocity_change(j);
+    }
     if (r.event) record_contact(w_, i, j, nullptr, t_abs, ctx_.dt);
     ++w_.version[i];
     ++w_.version[j];
     destroy_after(i, r.destroy_first);
     destroy_after(j, r.destroy_second);
     reschedule_pair(i, j, t);
+    if (!settled) {
+      free_dependents(i, t);
+      free_dependents(j, t);
+    }
   }
 
   void process_static(std::uint32_t i, std::uint32_t k, std::uint8_t feature, double t, double t_abs) {
@@ -418,6 +456,7 @@ class EventLoop {
     ++w_.version[i];
     destroy_after(i, r.destroy_first);
     reschedule(i, t);
+    free_dependents(i, t);
   }
 
   void finish_with_lecture_pass(double t) {

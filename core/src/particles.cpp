@@ -53,6 +53,8 @@ void spawn(World& w, EmitterState& e, std::uint16_t emitter, Vec2 p, Vec2 v, dou
     w.apath.push_back({});
     w.support.push_back(kNone);
     w.support_n.push_back({});
+    w.dep_head.push_back(kNone);
+    w.dep_next.push_back(kNone);
     w.last_partner.push_back(kNone);
     w.last_touch.push_back(-INFINITY);
   }

@@ -13,6 +13,12 @@
 // "block on an incline" is a circle on an inclined wall.
 // The support holds while the force presses the body into the face and its contact
 // point stays on the segment; leaving either way releases it.
+//
+// A body can also rest on another body that is itself at rest (stuck) on a support: a
+// stack. It must be held there (pressed, slow, static friction enough); it is then
+// stuck too, and it is released, with everything resting on it, the moment its
+// supporter moves or the force stops pressing it down. A body that would slide off a
+// body does not rest on it: it micro-bounces (exact_collisions.cpp).
 #include <algorithm>
 #include <cmath>
 
@@ -37,6 +43,11 @@ Coefficients coefficients(const World& w, std::uint32_t i, const Segment& s) {
 }  // namespace
 
 void support_path(World& w, std::uint32_t i) {
+  if (w.on_body(i)) {   // held in place by static friction on a body at rest
+    w.vel[i] = {};
+    w.apath[i] = {};
+    return;
+  }
   const Segment& s = w.statics.segments[w.support[i]];
   const Vec2 n = w.support_n[i];
   const Vec2 t = perp(n);
@@ -58,8 +69,44 @@ void support_path(World& w, std::uint32_t i) {
 }
 
 void release_support(World& w, std::uint32_t i) {
+  if (w.on_body(i)) {   // unlink from the supporter's list of dependents
+    const std::uint32_t j = w.support[i] & ~kBodySupport;
+    std::uint32_t* link = &w.dep_head[j];
+    while (*link != kNone && *link != i) link = &w.dep_next[*link];
+    if (*link == i) *link = w.dep_next[i];
+    w.dep_next[i] = kNone;
+  }
   w.support[i] = kNone;
   w.apath[i] = w.acc[i];   // free for the rest of the step
+}
+
+bool can_rest_on(const World& w, std::uint32_t i, std::uint32_t j, Vec2 n, double rest_speed) {
+  if (!w.stuck(j) || w.supported(i)) return false;
+  const Vec2 a = w.acc[i];
+  const double normal_per_mass = -dot(a, n);
+  if (!(normal_per_mass > 0.0)) return false;
+  if (length(w.vel[i]) > rest_speed) return false;
+  const PairMaterial m = w.pair_material(w.material[i], w.material[j]);
+  const double hold = m.rolling_friction > 0.0 ? m.rolling_friction : std::max(m.static_friction, m.friction);
+  return length(a + normal_per_mass * n) <= hold * normal_per_mass;
+}
+
+void rest_on_body(World& w, std::uint32_t i, std::uint32_t j, Vec2 n) {
+  w.vel[i] = {};
+  w.apath[i] = {};
+  w.support[i] = kBodySupport | j;
+  w.support_n[i] = n;
+  w.dep_next[i] = w.dep_head[j];
+  w.dep_head[j] = i;
+}
+
+void collect_dependents(World& w, std::uint32_t j) {
+  std::size_t k = w.released.size();
+  for (std::uint32_t d = w.dep_head[j]; d != kNone; d = w.dep_next[d]) w.released.push_back(d);
+  while (k < w.released.size()) {
+    const std::uint32_t x = w.released[k++];
+    for (std::uint32_t d = w.dep_head[x]; d != kNone; d = w.dep_next[d]) w.released.push_back(d);
+  }
 }
 
 namespace {
@@ -105,9 +152,10 @@ void apply_supports(World& w, const StepContext& ctx) {
       continue;
     }
     if (!w.dynamic(i)) {
-      w.support[i] = kNone;
+      release_support(w, i);
       continue;
     }
+    if (w.on_body(i)) continue;   // after every segment support is settled (below)
     const Segment& s = w.statics.segments[w.support[i]];
     const Vec2 nrm = w.support_n[i];
     const double u = dot(w.pos[i] - s.from, s.dir);
@@ -123,9 +171,35 @@ void apply_supports(World& w, const StepContext& ctx) {
     // Still touching at the end of this step: one continuing contact.
     if (!w.last_touch.empty()) w.last_touch[i] = ctx.t0;
   }
+  // Bodies at rest on bodies: valid while the supporter is stuck, they still touch, and
+  // they are still held. A stack settles from the bottom up, one level per pass.
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      if (!w.on_body(i)) continue;
+      const std::uint32_t j = w.support[i] & ~kBodySupport;
+      const Vec2 d = w.pos[i] - w.pos[j];
+      const double dist = length(d);
+      const double R = w.radius[i] + w.radius[j];
+      const double tol = 1e-9 * (R + w.length_scale);
+      const Vec2 nrm = dist > 0.0 ? d / dist : w.support_n[i];
+      w.support[i] = kNone;   // judged as a free body pressed onto j
+      const bool ok = w.alive(j) && std::fabs(dist - R) <= tol && can_rest_on(w, i, j, nrm, INFINITY);
+      w.support[i] = kBodySupport | j;
+      if (ok) {
+        w.support_n[i] = nrm;
+        support_path(w, i);
+        if (!w.last_touch.empty()) w.last_touch[i] = ctx.t0;
+      } else {
+        release_support(w, i);
+        changed = true;
+      }
+    }
+  }
 }
 
 double support_stop_time(const World& w, std::uint32_t i, double t, double T) {
+  if (w.on_body(i)) return toi::kNever;   // stuck
   const Vec2 tang = perp(w.support_n[i]);
   const double vt = dot(w.vel_at(i, t), tang);
   const double at = dot(w.apath[i], tang);
@@ -135,6 +209,7 @@ double support_stop_time(const World& w, std::uint32_t i, double t, double T) {
 }
 
 double support_leave_time(const World& w, std::uint32_t i, double t, double T) {
+  if (w.on_body(i)) return toi::kNever;
   const Segment& s = w.statics.segments[w.support[i]];
   const Vec2 p = w.pos_at(i, t);
   const Vec2 v = w.vel_at(i, t);

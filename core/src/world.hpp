@@ -24,6 +24,8 @@ enum class CollisionMode : std::uint8_t { Exact, Lecture };
 const char* integrator_name(Integrator i);
 
 inline constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+// support[i] names a segment, or with this bit a body (a body at rest on a body).
+inline constexpr std::uint32_t kBodySupport = 0x80000000u;
 
 enum BodyFlag : std::uint8_t {
   kAlive = 1,
@@ -159,8 +161,10 @@ struct World {
   std::vector<Vec2> vcorr;           // varying_forces: end-of-step velocity correction
   std::vector<ForceParams> fparams;  // drag or thrust only
   std::vector<ThrustDef> thrusts;
-  std::vector<std::uint32_t> support;   // any_forces: segment a body rests on, or kNone
-  std::vector<Vec2> support_n;
+  std::vector<std::uint32_t> support;   // any_forces: segment (or kBodySupport | body) a body rests on, or kNone
+  std::vector<Vec2> support_n;          // unit, from the support towards the body
+  std::vector<std::uint32_t> dep_head, dep_next;   // any_forces: bodies resting on each body (a list)
+  std::vector<std::uint32_t> released;             // scratch: bodies freed by their support moving
   std::vector<std::uint32_t> last_partner;   // any_forces: contact continuity
   std::vector<double> last_touch;
   // Names of the scene's bodies, packed: body i is name_chars[name_end[i-1], name_end[i])
@@ -218,6 +222,11 @@ struct World {
   bool is_static(std::uint32_t i) const { return (flags[i] & kStatic) != 0; }
   bool dynamic(std::uint32_t i) const { return (flags[i] & (kAlive | kStatic)) == kAlive; }
   bool supported(std::uint32_t i) const { return !support.empty() && support[i] != kNone; }
+  bool on_body(std::uint32_t i) const { return supported(i) && (support[i] & kBodySupport) != 0; }
+  // At rest on a support: not moving, and held there for the rest of the step.
+  bool stuck(std::uint32_t i) const {
+    return supported(i) && vel[i].x == 0.0 && vel[i].y == 0.0 && apath[i].x == 0.0 && apath[i].y == 0.0;
+  }
   Vec2 path_acc(std::uint32_t i) const { return apath.empty() ? Vec2{} : apath[i]; }
   Vec2 force_acc(std::uint32_t i) const { return acc.empty() ? Vec2{} : acc[i]; }
   // The acceleration that presses contacts: the constrained one for a supported body.
@@ -270,6 +279,13 @@ void explode_parent(World& w, std::uint32_t emitter, double t_abs);
 void support_path(World& w, std::uint32_t i);
 // Releases body i from its support.
 void release_support(World& w, std::uint32_t i);
+// Body i comes to rest on body j (stuck there), along n from j to i.
+void rest_on_body(World& w, std::uint32_t i, std::uint32_t j, Vec2 n);
+// Whether body i, pressed onto the stuck body j along n (from j to i), would stay put:
+// pressed, slow, and held by static friction.
+bool can_rest_on(const World& w, std::uint32_t i, std::uint32_t j, Vec2 n, double rest_speed);
+// Appends the bodies resting on j, and on those in turn, to w.released.
+void collect_dependents(World& w, std::uint32_t j);
 // Time within the step at which a supported body stops sliding or leaves its
 // segment, from time t (toi::kNever if not in [t, T]).
 double support_stop_time(const World& w, std::uint32_t i, double t, double T);

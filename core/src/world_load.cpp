@@ -186,7 +186,7 @@ void load_world(World& w, const Scene& scene) {
   if (w.newtonian) w.mass.reserve(cap);
   if (any_thrust) w.angle.reserve(cap);
   if (any_drag || any_thrust) w.fparams.reserve(cap);
-  if (w.any_forces) reserve_all(w.acc, w.apath, w.support, w.support_n, w.last_partner, w.last_touch);
+  if (w.any_forces) reserve_all(w.acc, w.apath, w.support, w.support_n, w.dep_head, w.dep_next, w.last_partner, w.last_touch);
   if (w.varying_forces) w.vcorr.reserve(cap);
 
   double extent = 0.0;
@@ -226,6 +226,8 @@ void load_world(World& w, const Scene& scene) {
       w.apath.push_back({});
       w.support.push_back(kNone);
       w.support_n.push_back({});
+      w.dep_head.push_back(kNone);
+      w.dep_next.push_back(kNone);
       w.last_partner.push_back(kNone);
       w.last_touch.push_back(-INFINITY);
     }
@@ -322,6 +324,7 @@ std::size_t World::memory_bytes() const {
   n += bytes_of(pos) + bytes_of(vel) + bytes_of(tloc) + bytes_of(inv_mass) + bytes_of(radius) + bytes_of(version);
   n += bytes_of(flags) + bytes_of(group) + bytes_of(material) + bytes_of(mass) + bytes_of(angle);
   n += bytes_of(acc) + bytes_of(apath) + bytes_of(vcorr) + bytes_of(fparams) + bytes_of(support);
+  n += bytes_of(dep_head) + bytes_of(dep_next) + bytes_of(released);
   n += bytes_of(support_n) + bytes_of(last_partner) + bytes_of(last_touch) + bytes_of(name_end);
   n += name_chars.capacity() + 1;
   n += bytes_of(birth) + bytes_of(lifetime) + bytes_of(parent) + bytes_of(emitters);
@@ -337,7 +340,7 @@ std::size_t World::memory_bytes() const {
 void kill_body(World& w, std::uint32_t i) {
   w.flags[i] = static_cast<std::uint8_t>(w.flags[i] & ~kAlive);
   ++w.version[i];
-  if (!w.support.empty()) w.support[i] = kNone;
+  if (w.supported(i)) release_support(w, i);
   if (!w.mass.empty()) w.mass[i] = 0.0;   // no longer attracts
 }
 

@@ -73,6 +73,43 @@ TEST(CoreResting, InelasticBouncesThenSettles) {
   EXPECT_TRUE(sim.engine.limits_hit().empty());
 }
 
+TEST(CoreResting, StackOfThreeRestsExactly) {
+  // Three circles stacked on the floor, e = 0: they stay exactly where they are, with
+  // one contact each and no events once settled.
+  for (const char* integ : {"semi_implicit_euler", "velocity_verlet", "rk4"}) {
+    SCOPED_TRACE(integ);
+    Scene s = scene_of({circle("bottom", {0.0, 0.5}, {}, 0.5, 1.0, 0.0), circle("middle", {0.0, 1.5}, {}, 0.5, 1.0, 0.0),
+                        circle("top", {0.0, 2.5}, {}, 0.5, 1.0, 0.0)},
+                       {wall("floor", {-5.0, 0.0}, {5.0, 0.0}, 0.0)}, {0.0, -g});
+    Sim sim(s, options(integ));
+    sim.step(1.0 / 60.0);
+    for (int k = 0; k < 300; ++k) {
+      sim.step(1.0 / 60.0);
+      ASSERT_EQ(sim.engine.last_step_stats().events, 0) << k;
+    }
+    for (std::size_t b = 0; b < 3; ++b) {
+      EXPECT_NEAR(sim.state(b).position.y, 0.5 + static_cast<double>(b), 1e-12);
+      EXPECT_EQ(length(sim.state(b).velocity), 0.0);
+    }
+    EXPECT_EQ(sim.contacts.size(), 3u);
+  }
+}
+
+TEST(CoreResting, KnockedOutSupportDropsTheStack) {
+  // A ball resting on another is left in the air when a third knocks the lower one
+  // away: it must fall to the floor (e = 0, so it lands and stays).
+  Scene s = scene_of({circle("bottom", {0.0, 0.5}, {}, 0.5, 1.0, 0.0), circle("top", {0.0, 1.5}, {}, 0.5, 1.0, 0.0),
+                      circle("striker", {-5.0, 0.5}, {4.0, 0.0}, 0.5, 1.0, 1.0)},
+                     {wall("floor", {-50.0, 0.0}, {50.0, 0.0}, 0.0)}, {0.0, -g});
+  Sim sim(s);
+  sim.run_until(0.5, 1.0 / 60.0);
+  EXPECT_NEAR(sim.state("top").position.y, 1.5, 1e-12);   // still stacked before the hit (t = 1)
+  sim.run_until(4.0, 1.0 / 60.0);
+  EXPECT_NEAR(sim.state("top").position.y, 0.5, 1e-9);    // fell to the floor
+  EXPECT_EQ(sim.state("top").velocity.y, 0.0);
+  EXPECT_GT(sim.state("bottom").position.x, 1.0);         // knocked away
+}
+
 TEST(CoreResting, RollsOffTheEndAndFalls) {
   // A ball sliding on a frictionless ledge leaves it and falls; it does not hang on.
   Scene s = scene_of({circle("ball", {0.0, 5.5}, {2.0, 0.0})}, {wall("ledge", {-1.0, 5.0}, {1.0, 5.0})}, {0.0, -g});
