@@ -294,12 +294,17 @@ SweepResult run_sweep(const Scene& scene, const SweepOptions& options, const Pro
         p.simulated_seconds = static_cast<double>(p.steps) * dt;
 
         // The first run is measured for error (runs are deterministic) and warms up.
+        const std::string what = "[" + std::to_string(done) + "/" + std::to_string(total) + "] " + engine.info.name +
+                                 (variant.label.empty() ? "" : " " + variant.label) + " dt " + dt_label(dt) + ": ";
+        say(what + "running");
+
         // The first run, in a child process, is the one measured for error: an engine
         // that crashes costs its point, not the sweep. Only a run that came back whole
         // is repeated in this process for timing (engines are deterministic). The
         // comparison may still find it diverged (energy running away).
         RunOptions isolated = ro;
         isolated.isolate = true;
+        isolated.timeout_seconds = options.timeout_seconds;
         RunRecord first = run_once_isolated(run_scene, engine, isolated);
         if (first.status == RunStatus::Ok) {
           try {
@@ -316,8 +321,7 @@ SweepResult run_sweep(const Scene& scene, const SweepOptions& options, const Pro
         p.engine_settings = first.settings;
         if (p.status == RunStatus::Ok) time_point(p, run_scene, engine, ro, options);
 
-        std::string line = "[" + std::to_string(done) + "/" + std::to_string(total) + "] " + p.engine +
-                           (p.setting.empty() ? "" : " " + p.setting) + " dt " + dt_label(dt) + ": ";
+        std::string line = what;
         if (p.status != RunStatus::Ok) {
           line += std::string(run_status_name(p.status)) + " (" + p.reason + ")";
         } else {

@@ -30,6 +30,8 @@ struct SweepOptions {
   // step(), so fast scenes are timed over more than a few microseconds.
   double min_seconds_per_repetition = 0.02;
   double spread_warning = 0.25;       // warn when (max - min) / median exceeds this
+  double timeout_seconds = 0.0;       // the first (isolated) run of a point; 0: none. A
+                                      // point that times out is an error, not timed.
 };
 
 // One engine configuration of the sweep: option overrides for the engine's table.
