@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -150,6 +151,29 @@ TEST(Report, DegradesWhenFieldsAreMissing) {
   EXPECT_NE(page.find("no &quot;references&quot;"), std::string::npos);
   EXPECT_NE(page.find("it &lt;crashed&gt; &amp; burned"), std::string::npos);
   for (const std::string& src : images(page)) EXPECT_TRUE(fs::exists(dir / src)) << src;
+  fs::remove_all(dir);
+}
+
+TEST(Report, WithoutGnuplotThePageIsWrittenAndTheErrorRaised) {
+  const fs::path dir = fresh_dir("nognuplot");
+  SuiteResult suite;
+  suite.scenarios.push_back(scenario("ball_drop", 0.4));
+  write_results(dir, suite);
+  const char* old_path = std::getenv("PATH");
+  const std::string saved = old_path != nullptr ? old_path : "";
+  ::setenv("PATH", "/nonexistent-physval-test", 1);
+  std::string message;
+  try {
+    write_report(dir);
+  } catch (const plot::PlotError& e) {
+    message = e.what();
+  }
+  ::setenv("PATH", saved.c_str(), 1);
+  EXPECT_NE(message.find("ball_drop_energy.png"), std::string::npos) << message;
+  ASSERT_TRUE(fs::exists(dir / "report.html"));
+  const std::string page = read_text(dir / "report.html");
+  EXPECT_NE(page.find("could not be drawn"), std::string::npos);
+  EXPECT_TRUE(images(page).empty());   // no links to pictures that do not exist
   fs::remove_all(dir);
 }
 
