@@ -233,10 +233,12 @@ class EventLoop {
   // Body i's path changed at time t: register its new path and find its next events.
   void reschedule(std::uint32_t i, double t) {
     if (!w_.alive(i)) return;
+    // Others find i through its registered box (grown to cover the new path); i's own
+    // new events can only be with bodies whose registered boxes meet its new path.
     const Aabb box = path_box(w_, i, t, T_);
     w_.bp->grow(i, box);
     w_.found.clear();
-    w_.bp->query(i, w_.found);
+    w_.bp->query_box(box, i, w_.found);
     for (std::uint32_t j : w_.found) schedule_pair(i, j, t);
     if (w_.dynamic(i)) schedule_statics(i, t, box);
     schedule_body(i, t);
@@ -253,13 +255,12 @@ class EventLoop {
     const Aabb box_i = path_box(w_, i, t, T_), box_j = path_box(w_, j, t, T_);
     w_.bp->grow(i, box_i);
     w_.bp->grow(j, box_j);
-    const Aabb reg_i = w_.bp->box(i), reg_j = w_.bp->box(j);
     w_.found.clear();
-    w_.bp->query_box(merge(reg_i, reg_j), kNone, w_.found);
+    w_.bp->query_box(merge(box_i, box_j), kNone, w_.found);
     for (std::uint32_t k : w_.found) {
       const Aabb& reg_k = w_.bp->box(k);
-      if (k != i && overlaps(reg_i, reg_k)) schedule_pair(i, k, t);   // includes (i, j)
-      if (k != i && k != j && overlaps(reg_j, reg_k)) schedule_pair(j, k, t);
+      if (k != i && overlaps(box_i, reg_k)) schedule_pair(i, k, t);   // includes (i, j)
+      if (k != i && k != j && overlaps(box_j, reg_k)) schedule_pair(j, k, t);
     }
     if (w_.dynamic(i)) schedule_statics(i, t, box_i);
     if (w_.dynamic(j)) schedule_statics(j, t, box_j);
