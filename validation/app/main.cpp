@@ -14,6 +14,7 @@
 #include "physval/adapters/registry.hpp"
 #include "physval/validation/console_table.hpp"
 #include "physval/validation/gate.hpp"
+#include "physval/validation/plot.hpp"
 #include "physval/validation/report.hpp"
 #include "physval/validation/results_json.hpp"
 #include "physval/validation/scenario_loader.hpp"
@@ -157,9 +158,15 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
       std::cout << "junit: " << junit << '\n';
     }
     if (report) {
-      write_report(o.out, progress);
-      end_progress(progress);
-      std::cout << "report: " << (std::filesystem::path(o.out) / "report.html").string() << '\n';
+      try {
+        write_report(o.out, progress);
+        end_progress(progress);
+        std::cout << "report: " << (std::filesystem::path(o.out) / "report.html").string() << '\n';
+      } catch (const plot::PlotError& e) {
+        // The results and the page are written; only plots are missing. Not bad input.
+        end_progress(progress);
+        std::cerr << "physval: warning: the report's plots could not be drawn: " << e.what() << '\n';
+      }
     }
   } catch (const std::exception& e) {
     std::cerr << "physval: could not write the results: " << e.what() << '\n';
@@ -267,6 +274,8 @@ int main(int argc, char** argv) {
   sweep->add_option("--duration", sweep_duration, "override the scenario's duration, seconds");
   sweep->add_flag("--no-settings", sweep_no_settings, "sweep step sizes only, each engine at its default settings");
   sweep->add_flag("--quiet", sweep_quiet, "no progress on the terminal");
+  double sweep_timeout = 0.0;
+  sweep->add_option("--timeout", sweep_timeout, "seconds a single measured run may take before it is stopped (0: no limit)");
 
   std::string report_dir;
   auto* report = app.add_subcommand("report", "write report.html with plots for a results folder of `run` or `gate`");
@@ -305,7 +314,13 @@ int main(int argc, char** argv) {
         return bad_input(report_dir + ": no results.json here (write one with `physval run PATH --out " + report_dir + "`)");
       }
       const Progress progress = terminal_progress(false);
-      write_report(report_dir, progress);
+      try {
+        write_report(report_dir, progress);
+      } catch (const plot::PlotError& e) {
+        end_progress(progress);
+        std::cerr << "physval: the report's plots could not be drawn: " << e.what() << '\n';
+        return kExitFailed;
+      }
       end_progress(progress);
       std::cout << "report: " << (std::filesystem::path(report_dir) / "report.html").string() << '\n';
       return 0;
@@ -324,6 +339,8 @@ int main(int argc, char** argv) {
         if (find_engine(e) == nullptr) return bad_input("--engines: no engine named \"" + e + "\" (see `physval engines`)");
       }
       if (sweep_repetitions < 1) return bad_input("--repetitions must be >= 1");
+      if (sweep_timeout < 0.0) return bad_input("--timeout must be >= 0");
+      so.timeout_seconds = sweep_timeout;
       so.engines = sweep_engines;
       so.repetitions = sweep_repetitions;
       so.settings = !sweep_no_settings;
@@ -339,7 +356,13 @@ int main(int argc, char** argv) {
       SweepResult result = run_sweep(*load.scene, so, progress);
       end_progress(progress);
       print_sweep_table(std::cout, result);
-      write_sweep(sweep_out, result);
+      try {
+        write_sweep(sweep_out, result);
+      } catch (const plot::PlotError& e) {
+        std::cerr << "physval: sweep.csv and sweep.json are written, but the plots could not be drawn: " << e.what()
+                  << '\n';
+        return kExitFailed;
+      }
       std::cout << "sweep: " << (std::filesystem::path(sweep_out) / "sweep.csv").string() << ", sweep.json, "
                 << "speed_vs_error.png, error_vs_dt.png in " << sweep_out << '\n';
       return 0;
