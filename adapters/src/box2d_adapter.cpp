@@ -255,8 +255,8 @@ void Box2DEngine::build_statics() {
     const SurfaceDef& s = scene_.surfaces[i];
     if (s.points.size() < 2) throw std::invalid_argument("surface '" + s.name + "' needs at least 2 points");
     // Box2D 2.4.1 chains are one-sided: a circle collides on the right of the chain's
-    // direction. The scene's normals say which side faces the bodies (default: the left
-    // of the point order), so the chain runs forward or backward to match them.
+    // direction. A surface faces the left of its point order (scenes with precomputed
+    // normals are unsupported), so the chain runs backwards to face that side.
     int left = 0;
     int right = 0;
     for (std::size_t k = 0; k + 1 < s.points.size(); ++k) {

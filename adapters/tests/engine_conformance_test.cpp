@@ -393,9 +393,8 @@ TEST_P(Conformance, BoxesSurfacesAndPointsBounce) {
   s.boxes.push_back(box);
   SurfaceDef surf;
   surf.name = "ramp";
-  // A valley with a flat floor; normals up (the left of the point order).
+  // A valley with a flat floor, facing up (the left of the point order).
   surf.points = {{-3.0, 0.8}, {-1.0, 0.5}, {1.0, 0.5}, {3.0, 0.8}};
-  for (std::size_t k = 0; k < surf.points.size(); ++k) surf.normals.push_back({0.0, 1.0});
   s.surfaces.push_back(surf);
   auto e = make_engine(traits().name, s);
   const auto events = run(*e, s, s.steps());

@@ -6,8 +6,13 @@
 namespace physval {
 
 int Scene::steps() const {
-  const double n = std::round(duration / dt);
+  const double n = std::ceil(duration / dt - 1e-9);
   return n < 1.0 ? 1 : static_cast<int>(n);
+}
+
+double Scene::last_step() const {
+  const double rest = duration - static_cast<double>(steps() - 1) * dt;
+  return std::abs(rest - dt) <= 1e-9 * dt ? dt : rest;
 }
 
 int Scene::body_index(const std::string& body_name) const {
@@ -88,6 +93,7 @@ const char* feature_name(Feature f) {
     case Feature::MaterialOverrides: return "material_overrides";
     case Feature::CollisionMatrix: return "collision_matrix";
     case Feature::Particles: return "particles";
+    case Feature::SurfaceNormals: return "surface_normals";
     case Feature::Count: break;
   }
   return "unknown";
@@ -112,6 +118,9 @@ std::vector<Feature> scene_features(const Scene& scene) {
   if (!scene.walls.empty()) use(Feature::Walls);
   if (!scene.boxes.empty()) use(Feature::Boxes);
   if (!scene.surfaces.empty()) use(Feature::Surfaces);
+  for (const SurfaceDef& sf : scene.surfaces) {
+    if (!sf.normals.empty()) use(Feature::SurfaceNormals);
+  }
   for (const WallDef& w : scene.walls) material(w.material.friction, w.material.static_friction, w.material.rolling_friction);
   for (const BoxDef& w : scene.boxes) material(w.material.friction, w.material.static_friction, w.material.rolling_friction);
   for (const SurfaceDef& w : scene.surfaces) material(w.material.friction, w.material.static_friction, w.material.rolling_friction);

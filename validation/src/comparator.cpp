@@ -230,7 +230,6 @@ Reference make_reference(const Scene& scene, const RunOptions& options) {
   auto variant = [&](int factor) {
     Scene s = scene;
     s.dt = scene.dt / factor;
-    s.duration = static_cast<double>(scene.steps()) * scene.dt;   // ends where the runs end
     s.sample_interval = static_cast<double>(every) * scene.dt;
     for (const auto& [k, v] : engine->reference_options) s.engine_options[engine->info.name][k] = v;
     return s;

@@ -167,7 +167,7 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
       r.series.states.push_back(states);
       return states_finite(states);
     };
-    auto update_probes = [&](double t, bool have_states) {
+    auto update_probes = [&](double t, double step_dt, bool have_states) {
       if (trackers.empty()) return;
       if (!have_states) engine->read_states(states);
       for (std::size_t k = 0; k < trackers.size(); ++k) {
@@ -191,7 +191,7 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
             const double target = 2.0 * std::numbers::pi * full;
             const double over = std::abs(trackers[k].accumulated) - target;
             const double frac = std::abs(delta) > 0.0 ? over / std::abs(delta) : 0.0;
-            p.last_full_rev_time = t - frac * scene.dt;
+            p.last_full_rev_time = t - frac * step_dt;
             p.full_revolutions = full;
           }
           p.revolutions = std::abs(trackers[k].accumulated) / (2.0 * std::numbers::pi);
@@ -205,11 +205,13 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
       r.reason = "the initial state is not finite";
       r.diverged_at = 0.0;
     }
-    update_probes(0.0, true);
+    update_probes(0.0, scene.dt, true);
     double wall = 0.0;
+    const double last_dt = scene.last_step();
     for (long k = 1; k <= n && r.status == RunStatus::Ok; ++k) {
+      const double h = k == n ? last_dt : scene.dt;
       const auto t0 = clock::now();
-      engine->step(scene.dt);
+      engine->step(h);
       wall += std::chrono::duration<double>(clock::now() - t0).count();
       r.steps = k;
       const std::vector<ContactEvent>& events = engine->contacts();
@@ -226,7 +228,7 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
         r.reason = "state became NaN or infinite";
         r.diverged_at = t;
       }
-      update_probes(t, sampled);
+      update_probes(t, h, sampled);
     }
     r.wall_seconds = wall;
     r.limits_hit = engine->limits_hit();

@@ -730,16 +730,6 @@ Scene read_scene(Context& ctx, const toml::table& root) {
       } else {
         sr.error_at(*nrm, "normals", std::string("expected an array of [x, y], got ") + type_name(*nrm));
       }
-    } else if (sd.points.size() >= 2) {
-      // Default: the left-hand normal of the polyline, averaged at interior points.
-      const std::size_t n = sd.points.size();
-      sd.normals.assign(n, Vec2{});
-      for (std::size_t k = 0; k + 1 < n; ++k) {
-        const Vec2 seg_n = normalized(perp(sd.points[k + 1] - sd.points[k]));
-        sd.normals[k] += seg_n;
-        sd.normals[k + 1] += seg_n;
-      }
-      for (Vec2& v : sd.normals) v = normalized(v);
     }
     read_material(sr, sd.material);
     s.surfaces.push_back(sd);

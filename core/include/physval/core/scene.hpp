@@ -81,12 +81,13 @@ struct BoxDef {
 };
 
 // A precomputed surface (the lecture's pinball table): an open polyline of collision
-// points, each with its surface normal. Normals default to the left-hand normal of
-// the polyline (from point i towards i+1), averaged at interior points.
+// points. With `normals`, each point carries the surface normal a bounce uses
+// (interpolated along each segment: a smooth bumper from a few points); without them
+// the surface is a plain polyline and each segment bounces off its geometric normal.
 struct SurfaceDef {
   std::string name;
   std::vector<Vec2> points;    // at least 2
-  std::vector<Vec2> normals;   // unit, one per point (the loader fills defaults)
+  std::vector<Vec2> normals;   // unit, one per point; empty: geometric normals
   StaticMaterial material;
   int line = 0;
 };
@@ -229,7 +230,10 @@ struct Scene {
   Expectations expect;
   GateDef gate;
 
-  int steps() const;   // round(duration / dt), at least 1
+  // A run takes steps() steps of dt, the last one shortened so that it ends exactly
+  // at `duration`: steps() = ceil(duration / dt) (a remainder under 1e-9 dt is round-off).
+  int steps() const;
+  double last_step() const;   // the length of the last step, in (0, dt]
   // Index of the body with this name, or -1.
   int body_index(const std::string& body_name) const;
 };
@@ -289,6 +293,7 @@ enum class Feature : std::uint8_t {
   MaterialOverrides,
   CollisionMatrix,
   Particles,
+  SurfaceNormals,      // a surface with precomputed (interpolated) response normals
   Count
 };
 const char* feature_name(Feature f);
