@@ -13,6 +13,9 @@ cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j "$jobs"
 ctest --test-dir build --output-on-failure -j "$jobs"
 
+echo "== Gate: core on the built-in suite, with its tight limits (JUnit: build/core-gate.xml)"
+./build/physval gate validation/scenarios --engines core --quiet --out build/core-gate --junit build/core-gate.xml
+
 echo "== AddressSanitizer + UndefinedBehaviorSanitizer build and tests"
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DPHYSVAL_SANITIZE=ON -DPHYSVAL_BENCHMARKS=OFF >/dev/null
 cmake --build build-asan -j "$jobs"
