@@ -95,6 +95,43 @@ TEST_F(Cli, CheckNamesFileLineAndKeyAndExitsTwo) {
   EXPECT_NE(r.output.find("bodies[0].radius"), std::string::npos) << r.output;
 }
 
+// Each kind of bad input, through the command: exit 2, and "file:line:" and the key named.
+TEST_F(Cli, CheckEveryKindOfBadFile) {
+  const std::string head = "name = \"k\"\nduration = 1.0\n";   // lines 1-2
+  const std::string body = "[[bodies]]\nname = \"a\"\nradius = 0.5\nposition = [0, 0]\n";   // lines 3-6
+  struct Case {
+    const char* kind;
+    std::string text;
+    int line;
+    const char* key;
+  };
+  const std::vector<Case> cases = {
+      {"unknown key", head + body + "colour = 3\n", 7, "bodies[0].colour"},
+      {"wrong type", head + "dt = \"fast\"\n", 3, "dt"},
+      {"missing required key", "name = \"k\"\n", 1, "duration"},
+      {"negative mass", head + body + "mass = -2\n", 7, "bodies[0].mass"},
+      {"zero mass", head + body + "mass = 0\n", 7, "bodies[0].mass"},
+      {"negative radius", head + "[[bodies]]\nname = \"a\"\nradius = -1\nposition = [0, 0]\n", 5, "bodies[0].radius"},
+      {"NaN", head + body + "velocity = [nan, 0]\n", 7, "bodies[0].velocity[0]"},
+      {"infinity", head + "dt = inf\n", 3, "dt"},
+      {"duplicate body name", head + body + body, 8, "bodies[1].name"},
+      {"zero-length wall", head + "[[walls]]\nfrom = [1, 1]\nto = [1, 1]\n", 3, "walls[0].to"},
+      {"non-positive dt", head + "dt = 0\n", 3, "dt"},
+      {"non-positive duration", "name = \"k\"\nduration = -1\n", 2, "duration"},
+      {"syntax error", head + "[[bodies]\n", 3, ""},
+  };
+  for (const Case& c : cases) {
+    const fs::path f = write("bad.toml", c.text);
+    const Result r = physval("check " + f.string());
+    EXPECT_EQ(r.status, 2) << c.kind << "\n" << r.output;
+    const std::string where = f.string() + ":" + std::to_string(c.line) + ":";
+    EXPECT_NE(r.output.find(where), std::string::npos) << c.kind << ": wanted " << where << "\n" << r.output;
+    if (*c.key != '\0') {
+      EXPECT_NE(r.output.find(std::string(": ") + c.key + ": "), std::string::npos) << c.kind << "\n" << r.output;
+    }
+  }
+}
+
 TEST_F(Cli, RunWithBadInputRunsNothingAndWritesNothing) {
   const fs::path bad = write("bad.toml", "name = \"bad\"\nduration = 0\n");
   const Result r = physval("run " + bad.string() + " --out " + (dir_ / "out").string());
