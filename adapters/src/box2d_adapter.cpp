@@ -358,10 +358,7 @@ void Box2DEngine::check_limits(double dt) {
   }
 }
 
-BodyMeta Box2DEngine::body_meta(std::size_t i) const {
-  const BodyDef& b = scene_.bodies.at(i);
-  return {b.name, b.is_static ? 0.0 : b.mass, b.shape == ShapeKind::Point ? 0.0 : b.radius, b.is_static};
-}
+BodyMeta Box2DEngine::body_meta(std::size_t i) const { return objects_->body_meta(i); }
 
 void Box2DEngine::read_states(std::vector<BodyState>& out) const {
   out.resize(bodies_.size());

@@ -51,6 +51,12 @@ class SceneObjects {
   // Walls, boxes and surfaces are permanent; only bodies can be destroyed.
   static bool destructible(ObjectRef r) { return r.kind == ObjectRef::Kind::Body; }
 
+  // What the comparator needs of scene body i: name, mass (0 when static), radius.
+  BodyMeta body_meta(std::size_t i) const {
+    const BodyDef& b = scene_.bodies.at(i);
+    return {b.name, b.is_static ? 0.0 : b.mass, b.shape == ShapeKind::Point ? 0.0 : b.radius, b.is_static};
+  }
+
  private:
   const Scene& scene_;
 };

@@ -1,5 +1,7 @@
 #include "physval/validation/gate.hpp"
 
+#include "markup_escape.hpp"
+
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -8,22 +10,7 @@ namespace physval {
 
 namespace {
 
-std::string xml_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t') out += ' ';
-        else out += c;
-    }
-  }
-  return out;
-}
+std::string xml_escape(const std::string& s) { return markup_escape(s); }
 
 std::string g(double v) {
   std::ostringstream os;

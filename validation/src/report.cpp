@@ -19,6 +19,7 @@
 
 #include "physval/validation/plot.hpp"
 #include "physval/validation/results_json.hpp"
+#include "markup_escape.hpp"
 #include "report_figures.hpp"
 
 namespace physval {
@@ -42,19 +43,7 @@ namespace {
 
 // ---- formatting -----------------------------------------------------------------
 
-std::string html(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
+std::string html(const std::string& s) { return markup_escape(s); }
 
 // A metric cell: the value, or a grey dash for null / missing ("does not apply").
 std::string metric_cell(const json& metrics, const char* key, const char* unit = "") {
