@@ -10,7 +10,9 @@
 // Times are CPU time of the benchmark thread (the machine is shared).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstdint>
+#include <cstdlib>
 #include <map>
 #include <memory>
 #include <string>
@@ -28,7 +30,11 @@ using physval::EngineOptions;
 // (300 steps) up to N = 10k. Box2D slows over its first few hundred steps (contacts
 // churn, memory scatters: shared/engines.md); the first steps would flatter it. At
 // 100k and 1M only core runs, and 10 warm-up steps keep the run short.
-int warmup_steps(int n) { return n <= 10000 ? 300 : 10; }
+// PHYSVAL_GAS_WARMUP=k overrides the count for every N (a steady-state check at 1M).
+int warmup_steps(int n) {
+  if (const char* env = std::getenv("PHYSVAL_GAS_WARMUP")) return std::max(0, std::atoi(env));
+  return n <= 10000 ? 300 : 10;
+}
 
 int timed_steps(int n) {
   if (n <= 1000) return 300;

@@ -10,6 +10,12 @@
 // its centre stays within a quarter cell of it (queries look that much further);
 // beyond, it moves home to its new centre's cell through an extra entry, and the
 // entry it leaves behind no longer matches.
+//
+// A box grown past a cell mid-step (a fast body deflected: its box covers the old
+// path and the new) is entered, through extra entries, in every cell it touches, so
+// queries meet it where they look; only one too large for that (more than 16 cells),
+// or oversize at the build, joins the list every query tests. (One list for all
+// would make each query cost a share of N: quadratic at a million bodies.)
 #include "broadphase_common.hpp"
 
 namespace physval {
@@ -17,6 +23,14 @@ namespace physval {
 namespace {
 
 using bp_detail::kNil;
+
+// home_x_ of an oversize body: no cell matches it (cell_of never returns INT32_MIN);
+// its home_y_ says whether it is in the list every query tests.
+constexpr std::int32_t kOversizeHome = std::numeric_limits<std::int32_t>::min();
+constexpr std::int32_t kInCells = 0, kInList = 1;
+// An extra entry for one cell an oversize body touches (the rest: the body's index).
+constexpr std::uint32_t kTouchEntry = 0x80000000u;
+constexpr std::int64_t kMaxTouchCells = 16;
 
 class GridBroadPhase final : public bp_detail::BroadPhaseBase {
  public:
@@ -123,6 +137,10 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     home_x_.resize(n);
     home_y_.resize(n);
     for (std::uint32_t k = 0; k < n; ++k) centre_cell(boxes_[k], home_x_[k], home_y_[k]);
+    for (std::uint32_t o : oversize_) {
+      home_x_[pos_of_[o]] = kOversizeHome;
+      home_y_[pos_of_[o]] = kInList;
+    }
     extra_head_.assign(hash_.buckets, kNil);
     extra_next_.clear();
     extra_body_.clear();
@@ -183,7 +201,14 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
         const std::uint32_t b = hash_(x, y);
         for (std::uint32_t k = start_[b]; k < start_[b + 1]; ++k) visit(k, x, y, q, stamp, out);
         for (std::uint32_t e = extra_head_[b]; e != kNil; e = extra_next_[e]) {
-          visit(pos_of_[extra_body_[e]], x, y, q, stamp, out);
+          const std::uint32_t body = extra_body_[e];
+          if (body & kTouchEntry) {
+            const std::uint32_t j = body & ~kTouchEntry;
+            const std::uint32_t k = pos_of_[j];
+            if (overlaps(q, boxes_[k]) && first_visit(k, stamp)) out.push_back(j);
+          } else {
+            visit(pos_of_[body], x, y, q, stamp, out);
+          }
         }
         if (x == x1) break;
       }
@@ -198,20 +223,37 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
   void grow(std::uint32_t i, const Aabb& b) override {
     const std::uint32_t k = pos_of_[i];
     const bool was_active = active_[i] != 0;
-    const bool was_oversize = was_active && bp_detail::extent(boxes_[k]) > cell_;
-    boxes_[k] = was_active ? merge(boxes_[k], b) : b;
+    const bool was_oversize = was_active && home_x_[k] == kOversizeHome;
+    if (was_oversize && home_y_[k] == kInList) {
+      boxes_[k] = merge(boxes_[k], b);
+      return;
+    }
+    const Aabb old = boxes_[k];
+    boxes_[k] = was_active ? merge(old, b) : b;
     active_[i] = 1;
-    if (was_oversize) return;
-    if (bp_detail::extent(boxes_[k]) > cell_) {
-      oversize_.push_back(i);
+    if (was_oversize || bp_detail::extent(boxes_[k]) > cell_) {
+      // Entries in the cells the box touches now and did not before (an oversize box
+      // only grows); the list if there are too many.
+      const CellRange now = cells_of(boxes_[k]);
+      if (now.count() > kMaxTouchCells) {
+        home_x_[k] = kOversizeHome;
+        home_y_[k] = kInList;
+        oversize_.push_back(i);
+        return;
+      }
+      const CellRange before = was_oversize ? cells_of(old) : CellRange{1, 1, 0, 0};
+      home_x_[k] = kOversizeHome;
+      home_y_[k] = kInCells;
+      for (std::int32_t y = now.y0; y <= now.y1; ++y) {
+        for (std::int32_t x = now.x0; x <= now.x1; ++x) {
+          if (!before.has(x, y)) add_extra(hash_(x, y), i | kTouchEntry);
+        }
+      }
       return;
     }
     if (was_active && near_home(k)) return;
     centre_cell(boxes_[k], home_x_[k], home_y_[k]);
-    const std::uint32_t bucket = hash_(home_x_[k], home_y_[k]);
-    extra_body_.push_back(i);
-    extra_next_.push_back(extra_head_[bucket]);
-    extra_head_[bucket] = static_cast<std::uint32_t>(extra_body_.size() - 1);
+    add_extra(hash_(home_x_[k], home_y_[k]), i);
   }
 
   std::size_t memory_bytes() const override {
@@ -222,6 +264,22 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
   }
 
  private:
+  struct CellRange {
+    std::int32_t x0, y0, x1, y1;   // empty when x0 > x1
+    std::int64_t count() const {
+      return x1 < x0 ? 0 : (static_cast<std::int64_t>(x1) - x0 + 1) * (static_cast<std::int64_t>(y1) - y0 + 1);
+    }
+    bool has(std::int32_t x, std::int32_t y) const { return x >= x0 && x <= x1 && y >= y0 && y <= y1; }
+  };
+  CellRange cells_of(const Aabb& b) const {
+    return {bp_detail::cell_of(b.min_x, inv_cell_), bp_detail::cell_of(b.min_y, inv_cell_),
+            bp_detail::cell_of(b.max_x, inv_cell_), bp_detail::cell_of(b.max_y, inv_cell_)};
+  }
+  void add_extra(std::uint32_t bucket, std::uint32_t entry) {
+    extra_body_.push_back(entry);
+    extra_next_.push_back(extra_head_[bucket]);
+    extra_head_[bucket] = static_cast<std::uint32_t>(extra_body_.size() - 1);
+  }
   static void push(std::vector<BodyPair>& out, std::uint32_t i, std::uint32_t j) {
     out.push_back(i < j ? BodyPair{i, j} : BodyPair{j, i});
   }
@@ -242,11 +300,9 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
   void visit(std::uint32_t k, std::int32_t x, std::int32_t y, const Aabb& q, std::uint32_t stamp,
              std::vector<std::uint32_t>& out) {
     // Only the body's entry in its home cell counts: entries left behind by grow(),
-    // other cells sharing the bucket and oversize boxes are skipped.
+    // other cells sharing the bucket and oversize boxes (no home) are skipped.
     if (home_x_[k] != x || home_y_[k] != y) return;
-    const Aabb& bk = boxes_[k];
-    if (!overlaps(q, bk) || bp_detail::extent(bk) > cell_) return;
-    if (first_visit(k, stamp)) out.push_back(order_[k]);
+    if (overlaps(q, boxes_[k]) && first_visit(k, stamp)) out.push_back(order_[k]);
   }
 
   double option_cell_ = 0.0;
