@@ -231,6 +231,7 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
       os << "set lmargin at screen 0.14\nset rmargin at screen " << (keys_outside ? "0.74" : "0.96") << "\n";
     } else {
       os << "unset lmargin\nunset rmargin\n";
+      if (panel.left_margin > 0) os << "set lmargin " << panel.left_margin << "\n";
     }
     os << (panel.equal_aspect ? "set size ratio -1\n" : "set size noratio\n");
     for (std::size_t i = 0; i < panel.labels.size(); ++i) {

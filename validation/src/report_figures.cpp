@@ -504,6 +504,12 @@ plot::Figure overview_figure(const std::vector<ScenarioView>& views, const std::
     p.y.max = n + 0.6;
     // Names once, on the left panel; the right one keeps the rows, unlabelled.
     for (std::size_t i = 0; i < views.size(); ++i) p.y.tics.emplace_back(row(i), k == 0 ? views[i].name : "");
+    if (k == 0) {
+      // gnuplot's own margin underestimates long names in a proportional font.
+      std::size_t longest = 0;
+      for (const ScenarioView& v : views) longest = std::max(longest, v.name.size());
+      p.left_margin = static_cast<int>(longest) + 3;
+    }
     for (const std::string& engine : engines) {
       plot::Series s;
       s.title = engine;

@@ -62,6 +62,7 @@ struct Panel {
   bool equal_aspect = false;       // one metre is as long on x as on y (trajectories)
   std::string note;                // small text under the title ("" for none)
   std::vector<Label> labels;
+  int left_margin = 0;             // characters left of the axes for long tic labels; 0: gnuplot's own
 };
 
 struct Figure {
