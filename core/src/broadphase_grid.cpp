@@ -44,13 +44,16 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     return boxes_;
   }
   const Aabb& box(std::uint32_t i) const override { return boxes_[pos_of_[i]]; }
+  void prefetch(std::uint32_t i) const override { __builtin_prefetch(&pos_of_[i]); }
 
   void build(std::span<const std::uint8_t> active) override {
     const std::size_t n = boxes_.size();
     active_.assign(active.begin(), active.end());
     active_.resize(n, 0);
-    stamp_.assign(n, 0);
-    stamp_value_ = 0;
+    if (stamp_.size() != n) {   // (stamps only grow: older ones never match a new query)
+      stamp_.assign(n, 0);
+      stamp_value_ = 0;
+    }
     oversize_.clear();
 
     double sum = 0.0, largest = 0.0;
@@ -116,32 +119,27 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
       order_[k] = i;
       pos_of_[i] = k;
     }
-    // Boxes into bucket order, in place, following the permutation's cycles (stamp_
-    // marks the positions done).
-    for (std::uint32_t k = 0; k < n; ++k) {
-      if (stamp_[k] != 0) continue;
-      const Aabb first = boxes_[k];
-      std::uint32_t j = k;
-      for (;;) {
-        stamp_[j] = 1;
-        const std::uint32_t src = order_[j];
-        if (src == k) {
-          boxes_[j] = first;
-          break;
-        }
-        boxes_[j] = boxes_[src];
-        j = src;
-      }
-    }
-    std::fill(stamp_.begin(), stamp_.end(), 0u);
+    // Boxes into bucket order: gathered into the second buffer (independent loads,
+    // where following the permutation's cycles in place waits on each in turn).
+    sorted_.resize(n);
     home_x_.resize(n);
     home_y_.resize(n);
-    for (std::uint32_t k = 0; k < n; ++k) centre_cell(boxes_[k], home_x_[k], home_y_[k]);
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const Aabb b = boxes_[order_[k]];
+      sorted_[k] = b;
+      centre_cell(b, home_x_[k], home_y_[k]);
+    }
+    boxes_.swap(sorted_);
     for (std::uint32_t o : oversize_) {
       home_x_[pos_of_[o]] = kOversizeHome;
       home_y_[pos_of_[o]] = kInList;
     }
-    extra_head_.assign(hash_.buckets, kNil);
+    if (extra_head_.size() == hash_.buckets) {
+      for (std::uint32_t b : extra_used_) extra_head_[b] = kNil;
+    } else {
+      extra_head_.assign(hash_.buckets, kNil);
+    }
+    extra_used_.clear();
     extra_next_.clear();
     extra_body_.clear();
   }
@@ -259,8 +257,10 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
   std::size_t memory_bytes() const override {
     return base_bytes() + (home_x_.capacity() + home_y_.capacity()) * sizeof(std::int32_t) +
            (start_.capacity() + order_.capacity() + pos_of_.capacity() + oversize_.capacity() +
-                           extra_head_.capacity() + extra_next_.capacity() + extra_body_.capacity()) *
-                              sizeof(std::uint32_t);
+                           extra_head_.capacity() + extra_next_.capacity() + extra_body_.capacity() +
+                           extra_used_.capacity()) *
+                              sizeof(std::uint32_t) +
+           sorted_.capacity() * sizeof(Aabb);
   }
 
  private:
@@ -276,6 +276,7 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
             bp_detail::cell_of(b.max_x, inv_cell_), bp_detail::cell_of(b.max_y, inv_cell_)};
   }
   void add_extra(std::uint32_t bucket, std::uint32_t entry) {
+    if (extra_head_[bucket] == kNil) extra_used_.push_back(bucket);
     extra_body_.push_back(entry);
     extra_next_.push_back(extra_head_[bucket]);
     extra_head_[bucket] = static_cast<std::uint32_t>(extra_body_.size() - 1);
@@ -315,6 +316,8 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
   std::vector<std::uint32_t> oversize_;
   std::vector<std::int32_t> home_x_, home_y_;   // home cell of the body at each position
   std::vector<std::uint32_t> extra_head_, extra_next_, extra_body_;
+  std::vector<std::uint32_t> extra_used_;   // buckets whose extra_head_ is set
+  std::vector<Aabb> sorted_;                // the boxes' other buffer (build)
 };
 
 }  // namespace

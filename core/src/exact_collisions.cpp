@@ -136,6 +136,7 @@ class EventLoop {
 
     while (!w_.heap.empty()) {
       const Event e = heap_pop(w_.heap);
+      if (!w_.heap.empty()) prefetch(w_.heap.front());
       if (!valid(e)) continue;
       if (ctx_.events >= ctx_.event_cap) {
         finish_with_lecture_pass(e.time);
@@ -148,6 +149,24 @@ class EventLoop {
 
  private:
   void push(const Event& e) { heap_push(w_.heap, e); }
+
+  // Asks for the memory the next event will read while this one is processed.
+  void prefetch(const Event& e) const {
+    prefetch_body(e.a);
+    if (e.kind() == EventKind::Pair) prefetch_body(e.b);
+  }
+  void prefetch_body(std::uint32_t i) const {
+    __builtin_prefetch(&w_.flags[i]);
+    __builtin_prefetch(&w_.version[i]);
+    __builtin_prefetch(&w_.pos[i]);
+    __builtin_prefetch(&w_.vel[i]);
+    __builtin_prefetch(&w_.tloc[i]);
+    __builtin_prefetch(&w_.radius[i]);
+    __builtin_prefetch(&w_.inv_mass[i]);
+    __builtin_prefetch(&w_.group[i]);
+    __builtin_prefetch(&w_.material[i]);
+    w_.bp->prefetch(i);
+  }
 
   bool valid(const Event& e) const {
     if (!w_.alive(e.a)) return false;

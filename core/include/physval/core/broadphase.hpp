@@ -98,6 +98,9 @@ class BroadPhase {
   // The registered box of body i.
   virtual const Aabb& box(std::uint32_t i) const = 0;
 
+  // A hint: body i's entry will be read or grown soon (fetch it into the cache).
+  virtual void prefetch(std::uint32_t i) const { (void)i; }
+
   // Bytes of storage held.
   virtual std::size_t memory_bytes() const = 0;
 };
