@@ -235,6 +235,10 @@ void print_engines(bool as_json) {
 int main(int argc, char** argv) {
   CLI::App app{"physval: runs 2-D physics scenarios on several engines and says where they disagree and by how much"};
   app.require_subcommand(1);
+  app.footer(
+      "Exit status: 0 everything ran and every enforced check held; 1 a gate or an expectation failed,\n"
+      "or an engine diverged; 2 bad input or usage (nothing was run). README.md documents every\n"
+      "scenario key, metric and option.");
   app.set_version_flag("--version", std::string("physval ") + PHYSVAL_VERSION);
 
   CommonOptions run_opts;
