@@ -199,7 +199,6 @@ struct World {
 
   // ---- broad phase and scratch
   std::unique_ptr<BroadPhase> bp;
-  std::vector<Aabb> boxes;
   std::vector<std::uint8_t> active;
   std::vector<BodyPair> pairs;
   std::vector<std::uint32_t> found;
