@@ -3,8 +3,8 @@
 // any speed and a contact's time is the root of its gap polynomial, not the step's end.
 //
 // Every body keeps its own clock (tloc) and is advanced lazily, only when an event
-// involves it. Candidate events sit in a min-heap ordered by (time, kind, bodies), so
-// the order is total and runs are bit-identical. An event is stale once a body it
+// involves it. Candidate events sit in a queue ordered by (time, kind, bodies), so
+// the order is total and runs are bit-identical (event_queue.cpp). An event is stale once a body it
 // names has changed its path since (each body carries a version). After an impact the
 // bodies involved register a box over their new path with the broad phase and are
 // tested against whatever it overlaps.
@@ -53,55 +53,6 @@ Aabb path_box(const World& w, std::uint32_t i, double t, double T) {
 
 namespace {
 
-// The queue's order: time, then kind (so simultaneous events resolve in a fixed
-// order), then bodies; total, so runs are bit-identical.
-bool later(const Event& x, const Event& y) {
-  if (x.time != y.time) return x.time > y.time;
-  const std::uint32_t kx = x.tag >> 28, ky = y.tag >> 28;   // kind and feature
-  if ((kx >> 1) != (ky >> 1)) return (kx >> 1) > (ky >> 1);
-  if (x.a != y.a) return x.a > y.a;
-  if (x.b != y.b) return x.b > y.b;
-  if (kx != ky) return kx > ky;
-  if (x.va != y.va) return x.va > y.va;
-  return x.tag > y.tag;
-}
-
-// A 4-ary min-heap: half the levels of a binary heap, four children in two cache lines.
-void heap_push(std::vector<Event>& h, const Event& e) {
-  std::size_t i = h.size();
-  h.push_back(e);
-  while (i > 0) {
-    const std::size_t parent = (i - 1) / 4;
-    if (!later(h[parent], e)) break;
-    h[i] = h[parent];
-    i = parent;
-  }
-  h[i] = e;
-}
-
-Event heap_pop(std::vector<Event>& h) {
-  const Event top = h.front();
-  const Event last = h.back();
-  h.pop_back();
-  const std::size_t n = h.size();
-  if (n == 0) return top;
-  std::size_t i = 0;
-  for (;;) {
-    const std::size_t first = 4 * i + 1;
-    if (first >= n) break;
-    std::size_t best = first;
-    const std::size_t end = std::min(first + 4, n);
-    for (std::size_t c = first + 1; c < end; ++c) {
-      if (later(h[best], h[c])) best = c;
-    }
-    if (!later(last, h[best])) break;
-    h[i] = h[best];
-    i = best;
-  }
-  h[i] = last;
-  return top;
-}
-
 double inf_norm(Vec2 v) { return std::max(std::fabs(v.x), std::fabs(v.y)); }
 
 class EventLoop {
@@ -110,7 +61,7 @@ class EventLoop {
 
   void run() {
     prune_passing(w_);
-    w_.heap.clear();
+    w_.events.start(T_);
     const std::size_t n = w_.size();
     std::span<Aabb> boxes = w_.bp->prepare(n);
     w_.active.resize(n);
@@ -131,12 +82,13 @@ class EventLoop {
     if (!w_.emitters.empty()) {
       w_.scratch_events.clear();
       schedule_explosions(w_, ctx_, w_.scratch_events);
-      for (const Event& e : w_.scratch_events) heap_push(w_.heap, e);
+      for (const Event& e : w_.scratch_events) push(e);
     }
 
-    while (!w_.heap.empty()) {
-      const Event e = heap_pop(w_.heap);
-      if (!w_.heap.empty()) prefetch(w_.heap.front());
+    w_.events.seal();
+    while (!w_.events.empty()) {
+      const Event e = w_.events.pop();
+      if (const Event* next = w_.events.next()) prefetch(*next);
       if (!valid(e)) continue;
       if (ctx_.events >= ctx_.event_cap) {
         finish_with_lecture_pass(e.time);
@@ -148,7 +100,7 @@ class EventLoop {
   }
 
  private:
-  void push(const Event& e) { heap_push(w_.heap, e); }
+  void push(const Event& e) { w_.events.push(e); }
 
   // Asks for the memory the next event will read while this one is processed.
   void prefetch(const Event& e) const {
@@ -483,7 +435,7 @@ class EventLoop {
     w_.stats.event_cap_hit = true;
     if (w_.cap_hits == 0) w_.first_cap_time = ctx_.t0 + t;
     ++w_.cap_hits;
-    w_.heap.clear();
+    w_.events.clear();
     for (std::uint32_t i = 0; i < w_.size(); ++i) {
       if (w_.dynamic(i)) w_.advance(i, t);
     }

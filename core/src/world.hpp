@@ -16,6 +16,7 @@
 #include "physval/core/core_engine.hpp"
 #include "physval/core/scene.hpp"
 #include "physval/core/vec2.hpp"
+#include "event_queue.hpp"
 
 namespace physval::core_detail {
 
@@ -72,35 +73,6 @@ struct ForceParams {
   double drag_linear = 0.0;
   double drag_quadratic = 0.0;
   std::int32_t thrust = -1;   // index into World::thrusts
-};
-
-enum class EventKind : std::uint8_t {
-  Explode,    // a = body (the parent), b = emitter
-  Pair,       // a < b, bodies
-  Static,     // a = body, b = segment, feature = 0 face, 1 cap at from, 2 cap at to
-  Stop,       // a = body sliding on its support comes to rest (friction)
-  Leave,      // a = body's support point leaves the end of its segment
-  Expire,     // a = particle reaches its lifetime
-};
-
-// 24 bytes: the version of b shares its word with the kind and the feature (versions
-// are compared modulo 2^28, far more changes than one step can make).
-struct Event {
-  double time = 0.0;   // within the step, s from its start
-  std::uint32_t a = 0, b = 0;
-  std::uint32_t va = 0;       // version of a when computed
-  std::uint32_t tag = 0;      // kind << 29 | feature << 28 | version of b (28 bits)
-
-  static constexpr std::uint32_t kVersionMask = (1u << 28) - 1u;
-  static Event make(double time, std::uint32_t a, std::uint32_t b, std::uint32_t va, std::uint32_t vb,
-                    EventKind kind, std::uint8_t feature = 0) {
-    return {time, a, b, va,
-            (static_cast<std::uint32_t>(kind) << 29) | (static_cast<std::uint32_t>(feature & 1u) << 28) |
-                (vb & kVersionMask)};
-  }
-  EventKind kind() const { return static_cast<EventKind>(tag >> 29); }
-  std::uint8_t feature() const { return static_cast<std::uint8_t>((tag >> 28) & 1u); }
-  std::uint32_t vb() const { return tag & kVersionMask; }
 };
 
 struct EmitterState {
@@ -203,7 +175,7 @@ struct World {
   std::vector<BodyPair> pairs;
   std::vector<std::uint32_t> found;
   std::vector<std::uint32_t> found_static;
-  std::vector<Event> heap;
+  EventQueue events;
   std::vector<Event> scratch_events;
   std::vector<std::uint64_t> passing;   // pass-through pairs now overlapping, sorted
   std::vector<Vec2> scratch_p, scratch_v, scratch_a[4], scratch_f;   // rk4, verlet, lecture

@@ -312,7 +312,7 @@ void load_world(World& w, const Scene& scene) {
   if (w.broadphase_auto) w.broadphase = choose_broadphase(w.radius);
   w.bp = make_broadphase(w.broadphase, w.cell_size);
   w.active.reserve(cap);
-  w.heap.reserve(std::max<std::size_t>(64, cap / 2));
+  if (w.mode == CollisionMode::Exact) w.events.reserve(cap / 4, cap / 16);
   w.contacts.reserve(std::max<std::size_t>(64, cap / 4));
   w.passing.reserve(16);
   w.time = 0.0;
@@ -330,7 +330,7 @@ std::size_t World::memory_bytes() const {
   n += statics.memory_bytes() + bytes_of(material_table) + bytes_of(responses) + bytes_of(materials);
   n += bp ? bp->memory_bytes() : 0;
   n += bytes_of(active) + bytes_of(pairs) + bytes_of(found) + bytes_of(found_static);
-  n += bytes_of(heap) + bytes_of(passing) + bytes_of(scratch_p) + bytes_of(scratch_v) + bytes_of(scratch_f);
+  n += events.memory_bytes() + bytes_of(passing) + bytes_of(scratch_p) + bytes_of(scratch_v) + bytes_of(scratch_f);
   for (const auto& s : scratch_a) n += bytes_of(s);
   n += bytes_of(contacts);
   return n;
