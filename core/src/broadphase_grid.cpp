@@ -4,8 +4,10 @@
 // would make every cell huge, so the cell is capped at 4x the mean box; boxes larger
 // than a cell are "oversize" and tested against every body.
 //
-// The boxes are stored in bucket order (the sort permutes them in place), so a
-// query scans neighbouring cells through contiguous memory. Each body has a home
+// The boxes are stored in bucket order (gathered at the build), so a query scans
+// neighbouring cells through contiguous memory; each position's box, home cell, body
+// and query stamp share one 32-byte slot, so a visit costs one cache line (at a
+// million bodies every visit of a query is a miss). Each body has a home
 // cell, that of its box centre at the build. A box grown mid-step keeps its home while
 // its centre stays within a quarter cell of it (queries look that much further);
 // beyond, it moves home to its new centre's cell through an extra entry, and the
@@ -24,13 +26,21 @@ namespace {
 
 using bp_detail::kNil;
 
-// home_x_ of an oversize body: no cell matches it (cell_of never returns INT32_MIN);
-// its home_y_ says whether it is in the list every query tests.
+// The home x of an oversize body: no cell matches it (cell_of never returns INT32_MIN);
+// its home y says whether it is in the list every query tests.
 constexpr std::int32_t kOversizeHome = std::numeric_limits<std::int32_t>::min();
 constexpr std::int32_t kInCells = 0, kInList = 1;
 // An extra entry for one cell an oversize body touches (the rest: the body's index).
 constexpr std::uint32_t kTouchEntry = 0x80000000u;
 constexpr std::int64_t kMaxTouchCells = 16;
+
+// Everything a query reads about the body at one position of the bucket order.
+struct alignas(32) Slot {
+  Aabb box;
+  std::int32_t hx = 0, hy = 0;   // home cell (hx = kOversizeHome: oversize)
+  std::uint32_t body = 0;
+  std::uint32_t stamp = 0;       // the last query that reported it
+};
 
 class GridBroadPhase final : public bp_detail::BroadPhaseBase {
  public:
@@ -38,32 +48,42 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
 
   BroadPhaseKind kind() const override { return BroadPhaseKind::Grid; }
 
-  // Filled in body order; build() permutes them into bucket order.
+  // Filled in body order; build() gathers them into the slots, in bucket order.
   std::span<Aabb> prepare(std::size_t n) override {
     boxes_.resize(n);
     return boxes_;
   }
-  const Aabb& box(std::uint32_t i) const override { return boxes_[pos_of_[i]]; }
-  void prefetch(std::uint32_t i) const override { __builtin_prefetch(&pos_of_[i]); }
+  const Aabb& box(std::uint32_t i) const override { return slots_[pos_of_[i]].box; }
+  void prefetch(std::uint32_t i) const override {
+    __builtin_prefetch(&pos_of_[i]);
+    __builtin_prefetch(&active_[i]);
+  }
 
   void build(std::span<const std::uint8_t> active) override {
     const std::size_t n = boxes_.size();
     active_.assign(active.begin(), active.end());
     active_.resize(n, 0);
-    if (stamp_.size() != n) {   // (stamps only grow: older ones never match a new query)
-      stamp_.assign(n, 0);
-      stamp_value_ = 0;
-    }
+    slots_.resize(n);
     oversize_.clear();
 
+    // One pass for the cell size and the range of the box centres (a pass each costs
+    // memory bandwidth at a million bodies).
     double sum = 0.0, largest = 0.0;
     std::size_t count = 0;
+    double lo_x = std::numeric_limits<double>::infinity(), hi_x = -lo_x, lo_y = lo_x, hi_y = -lo_x;
     for (std::size_t i = 0; i < n; ++i) {
       if (!active_[i]) continue;
-      const double e = bp_detail::extent(boxes_[i]);
+      const Aabb& b = boxes_[i];
+      const double e = bp_detail::extent(b);
       sum += e;
       largest = std::max(largest, e);
       ++count;
+      const double cx = 0.5 * (static_cast<double>(b.min_x) + b.max_x);
+      const double cy = 0.5 * (static_cast<double>(b.min_y) + b.max_y);
+      lo_x = std::min(lo_x, cx);
+      hi_x = std::max(hi_x, cx);
+      lo_y = std::min(lo_y, cy);
+      hi_y = std::max(hi_y, cy);
     }
     const double mean = count > 0 ? sum / static_cast<double>(count) : 0.0;
     double cell = largest;
@@ -73,67 +93,63 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     cell_ = cell;
     inv_cell_ = 1.0 / cell;
 
-    // Cells of the binned bodies, kept in order_ / pos_of_ for now (kUnbinned: oversize
-    // or inactive; cell_of never returns INT32_MIN).
-    constexpr std::uint32_t kUnbinned = 0x80000000u;
-    pos_of_.resize(n);
-    order_.resize(n);
-    std::int32_t x_lo = std::numeric_limits<std::int32_t>::max(), x_hi = std::numeric_limits<std::int32_t>::min();
-    std::int32_t y_lo = x_lo, y_hi = x_hi;
-    for (std::uint32_t i = 0; i < n; ++i) {
-      if (!active_[i]) {
-        order_[i] = kUnbinned;
-        continue;
+    // The occupied cells (of the binned bodies: cell_of is monotone, so the cells of
+    // the extreme centres). With oversize boxes (the cell capped), a pass without them.
+    if (largest > cell_) {
+      lo_x = lo_y = std::numeric_limits<double>::infinity();
+      hi_x = hi_y = -lo_x;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (!active_[i] || bp_detail::extent(boxes_[i]) > cell_) continue;
+        const Aabb& b = boxes_[i];
+        const double cx = 0.5 * (static_cast<double>(b.min_x) + b.max_x);
+        const double cy = 0.5 * (static_cast<double>(b.min_y) + b.max_y);
+        lo_x = std::min(lo_x, cx);
+        hi_x = std::max(hi_x, cx);
+        lo_y = std::min(lo_y, cy);
+        hi_y = std::max(hi_y, cy);
       }
+    }
+    const bool any = lo_x <= hi_x;
+    const std::int64_t cells_x =
+        any ? static_cast<std::int64_t>(bp_detail::cell_of(hi_x, inv_cell_)) - bp_detail::cell_of(lo_x, inv_cell_) + 1 : 1;
+    const std::int64_t cells_y =
+        any ? static_cast<std::int64_t>(bp_detail::cell_of(hi_y, inv_cell_)) - bp_detail::cell_of(lo_y, inv_cell_) + 1 : 1;
+    hash_.choose(count, cells_x, cells_y);
+
+    // Each body's bucket (kNil: inactive or oversize), counted.
+    start_.assign(hash_.buckets + 2, 0);
+    pos_of_.resize(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      pos_of_[i] = kNil;
+      if (!active_[i]) continue;
       if (bp_detail::extent(boxes_[i]) > cell_) {
-        order_[i] = kUnbinned;
         oversize_.push_back(i);
         continue;
       }
       std::int32_t cx, cy;
       centre_cell(boxes_[i], cx, cy);
-      order_[i] = static_cast<std::uint32_t>(cx);
-      pos_of_[i] = static_cast<std::uint32_t>(cy);
-      x_lo = std::min(x_lo, cx);
-      x_hi = std::max(x_hi, cx);
-      y_lo = std::min(y_lo, cy);
-      y_hi = std::max(y_hi, cy);
-    }
-    const bool any = x_lo <= x_hi;
-    hash_.choose(count, any ? static_cast<std::int64_t>(x_hi) - x_lo + 1 : 1,
-                 any ? static_cast<std::int64_t>(y_hi) - y_lo + 1 : 1);
-    start_.assign(hash_.buckets + 2, 0);
-    for (std::uint32_t i = 0; i < n; ++i) {
-      if (order_[i] == kUnbinned) {
-        pos_of_[i] = kNil;
-        continue;
-      }
-      pos_of_[i] = hash_(static_cast<std::int32_t>(order_[i]), static_cast<std::int32_t>(pos_of_[i]));
+      pos_of_[i] = hash_(cx, cy);
       ++start_[pos_of_[i] + 2];
     }
     // Counting sort: start_[b + 1] becomes the fill cursor of bucket b, then its end.
+    // Each body's slot is written whole where it lands (stamp 0: no query has it).
     for (std::uint32_t b = 0; b < hash_.buckets; ++b) start_[b + 2] += start_[b + 1];
     std::uint32_t tail = start_[hash_.buckets + 1];   // unbinned bodies after the buckets
     for (std::uint32_t i = 0; i < n; ++i) {
       const std::uint32_t k = pos_of_[i] == kNil ? tail++ : start_[pos_of_[i] + 1]++;
-      order_[k] = i;
+      Slot s;
+      s.box = boxes_[i];
+      centre_cell(s.box, s.hx, s.hy);
+      s.body = i;
+      s.stamp = 0;
+      slots_[k] = s;
       pos_of_[i] = k;
     }
-    // Boxes into bucket order: gathered into the second buffer (independent loads,
-    // where following the permutation's cycles in place waits on each in turn).
-    sorted_.resize(n);
-    home_x_.resize(n);
-    home_y_.resize(n);
-    for (std::uint32_t k = 0; k < n; ++k) {
-      const Aabb b = boxes_[order_[k]];
-      sorted_[k] = b;
-      centre_cell(b, home_x_[k], home_y_[k]);
-    }
-    boxes_.swap(sorted_);
     for (std::uint32_t o : oversize_) {
-      home_x_[pos_of_[o]] = kOversizeHome;
-      home_y_[pos_of_[o]] = kInList;
+      slots_[pos_of_[o]].hx = kOversizeHome;
+      slots_[pos_of_[o]].hy = kInList;
     }
+    stamp_value_ = 0;
     if (extra_head_.size() == hash_.buckets) {
       for (std::uint32_t b : extra_used_) extra_head_[b] = kNil;
     } else {
@@ -149,10 +165,12 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     for (std::uint32_t b = 0; b < hash_.buckets; ++b) {
       const std::uint32_t end = start_[b + 1];
       for (std::uint32_t k = start_[b]; k < end; ++k) {
-        const Aabb& a = boxes_[k];
-        const std::int32_t cx = home_x_[k], cy = home_y_[k];
+        const Slot& sk = slots_[k];
+        const Aabb& a = sk.box;
+        const std::int32_t cx = sk.hx, cy = sk.hy;
         for (std::uint32_t k2 = k + 1; k2 < end; ++k2) {
-          if (overlaps(a, boxes_[k2]) && home_x_[k2] == cx && home_y_[k2] == cy) push(out, order_[k], order_[k2]);
+          const Slot& s2 = slots_[k2];
+          if (overlaps(a, s2.box) && s2.hx == cx && s2.hy == cy) push(out, sk.body, s2.body);
         }
         for (const auto& d : kForward) {
           const std::int64_t nx = static_cast<std::int64_t>(cx) + d[0];
@@ -161,7 +179,8 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
           const auto ncx = static_cast<std::int32_t>(nx), ncy = static_cast<std::int32_t>(ny);
           const std::uint32_t nb = hash_(ncx, ncy);
           for (std::uint32_t k2 = start_[nb]; k2 < start_[nb + 1]; ++k2) {
-            if (overlaps(a, boxes_[k2]) && home_x_[k2] == ncx && home_y_[k2] == ncy) push(out, order_[k], order_[k2]);
+            const Slot& s2 = slots_[k2];
+            if (overlaps(a, s2.box) && s2.hx == ncx && s2.hy == ncy) push(out, sk.body, s2.body);
           }
         }
       }
@@ -179,18 +198,18 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
 
   void query_box(const Aabb& q, std::uint32_t exclude, std::vector<std::uint32_t>& out) override {
     const std::uint32_t stamp = next_stamp();
-    if (exclude < pos_of_.size()) stamp_[pos_of_[exclude]] = stamp;
+    if (exclude < pos_of_.size()) slots_[pos_of_[exclude]].stamp = stamp;
     const double half = 0.75 * cell_;   // half a cell, and the quarter a home may drift
     const std::int32_t x0 = bp_detail::cell_of(q.min_x - half, inv_cell_);
     const std::int32_t x1 = bp_detail::cell_of(q.max_x + half, inv_cell_);
     const std::int32_t y0 = bp_detail::cell_of(q.min_y - half, inv_cell_);
     const std::int32_t y1 = bp_detail::cell_of(q.max_y + half, inv_cell_);
     const double cells = (static_cast<double>(x1) - x0 + 1.0) * (static_cast<double>(y1) - y0 + 1.0);
-    if (cells > static_cast<double>(boxes_.size())) {
+    if (cells > static_cast<double>(slots_.size())) {
       // A box wider than the whole scene's cells: test everyone.
       for (std::uint32_t j = 0; j < active_.size(); ++j) {
         const std::uint32_t k = pos_of_[j];
-        if (active_[j] && first_visit(k, stamp) && overlaps(q, boxes_[k])) out.push_back(j);
+        if (active_[j] && first_visit(k, stamp) && overlaps(q, slots_[k].box)) out.push_back(j);
       }
       return;
     }
@@ -203,7 +222,7 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
           if (body & kTouchEntry) {
             const std::uint32_t j = body & ~kTouchEntry;
             const std::uint32_t k = pos_of_[j];
-            if (overlaps(q, boxes_[k]) && first_visit(k, stamp)) out.push_back(j);
+            if (overlaps(q, slots_[k].box) && first_visit(k, stamp)) out.push_back(j);
           } else {
             visit(pos_of_[body], x, y, q, stamp, out);
           }
@@ -214,34 +233,34 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     }
     for (std::uint32_t o : oversize_) {
       const std::uint32_t k = pos_of_[o];
-      if (first_visit(k, stamp) && overlaps(q, boxes_[k])) out.push_back(o);
+      if (first_visit(k, stamp) && overlaps(q, slots_[k].box)) out.push_back(o);
     }
   }
 
   void grow(std::uint32_t i, const Aabb& b) override {
-    const std::uint32_t k = pos_of_[i];
+    Slot& s = slots_[pos_of_[i]];
     const bool was_active = active_[i] != 0;
-    const bool was_oversize = was_active && home_x_[k] == kOversizeHome;
-    if (was_oversize && home_y_[k] == kInList) {
-      boxes_[k] = merge(boxes_[k], b);
+    const bool was_oversize = was_active && s.hx == kOversizeHome;
+    if (was_oversize && s.hy == kInList) {
+      s.box = merge(s.box, b);
       return;
     }
-    const Aabb old = boxes_[k];
-    boxes_[k] = was_active ? merge(old, b) : b;
+    const Aabb old = s.box;
+    s.box = was_active ? merge(old, b) : b;
     active_[i] = 1;
-    if (was_oversize || bp_detail::extent(boxes_[k]) > cell_) {
+    if (was_oversize || bp_detail::extent(s.box) > cell_) {
       // Entries in the cells the box touches now and did not before (an oversize box
       // only grows); the list if there are too many.
-      const CellRange now = cells_of(boxes_[k]);
+      const CellRange now = cells_of(s.box);
       if (now.count() > kMaxTouchCells) {
-        home_x_[k] = kOversizeHome;
-        home_y_[k] = kInList;
+        s.hx = kOversizeHome;
+        s.hy = kInList;
         oversize_.push_back(i);
         return;
       }
       const CellRange before = was_oversize ? cells_of(old) : CellRange{1, 1, 0, 0};
-      home_x_[k] = kOversizeHome;
-      home_y_[k] = kInCells;
+      s.hx = kOversizeHome;
+      s.hy = kInCells;
       for (std::int32_t y = now.y0; y <= now.y1; ++y) {
         for (std::int32_t x = now.x0; x <= now.x1; ++x) {
           if (!before.has(x, y)) add_extra(hash_(x, y), i | kTouchEntry);
@@ -249,18 +268,16 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
       }
       return;
     }
-    if (was_active && near_home(k)) return;
-    centre_cell(boxes_[k], home_x_[k], home_y_[k]);
-    add_extra(hash_(home_x_[k], home_y_[k]), i);
+    if (was_active && near_home(s)) return;
+    centre_cell(s.box, s.hx, s.hy);
+    add_extra(hash_(s.hx, s.hy), i);
   }
 
   std::size_t memory_bytes() const override {
-    return base_bytes() + (home_x_.capacity() + home_y_.capacity()) * sizeof(std::int32_t) +
-           (start_.capacity() + order_.capacity() + pos_of_.capacity() + oversize_.capacity() +
-                           extra_head_.capacity() + extra_next_.capacity() + extra_body_.capacity() +
-                           extra_used_.capacity()) *
-                              sizeof(std::uint32_t) +
-           sorted_.capacity() * sizeof(Aabb);
+    return base_bytes() + slots_.capacity() * sizeof(Slot) +
+           (start_.capacity() + pos_of_.capacity() + oversize_.capacity() + extra_head_.capacity() +
+            extra_next_.capacity() + extra_body_.capacity() + extra_used_.capacity()) *
+               sizeof(std::uint32_t);
   }
 
  private:
@@ -288,22 +305,39 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     cx = bp_detail::cell_of(0.5 * (static_cast<double>(b.min_x) + b.max_x), inv_cell_);
     cy = bp_detail::cell_of(0.5 * (static_cast<double>(b.min_y) + b.max_y), inv_cell_);
   }
-  // The centre of the box at position k is within a quarter cell of its home cell.
-  bool near_home(std::uint32_t k) const {
-    const Aabb& b = boxes_[k];
+  // The centre of the slot's box is within a quarter cell of its home cell.
+  bool near_home(const Slot& s) const {
+    const Aabb& b = s.box;
     const double cx = 0.5 * (static_cast<double>(b.min_x) + b.max_x);
     const double cy = 0.5 * (static_cast<double>(b.min_y) + b.max_y);
     const double q = 0.25 * cell_;
     // Strictly below the upper bound, as a centre binned by floor() is: queries rely on it.
-    return cx >= home_x_[k] * cell_ - q && cx < (home_x_[k] + 1.0) * cell_ + q && cy >= home_y_[k] * cell_ - q &&
-           cy < (home_y_[k] + 1.0) * cell_ + q;
+    return cx >= s.hx * cell_ - q && cx < (s.hx + 1.0) * cell_ + q && cy >= s.hy * cell_ - q &&
+           cy < (s.hy + 1.0) * cell_ + q;
   }
   void visit(std::uint32_t k, std::int32_t x, std::int32_t y, const Aabb& q, std::uint32_t stamp,
              std::vector<std::uint32_t>& out) {
     // Only the body's entry in its home cell counts: entries left behind by grow(),
     // other cells sharing the bucket and oversize boxes (no home) are skipped.
-    if (home_x_[k] != x || home_y_[k] != y) return;
-    if (overlaps(q, boxes_[k]) && first_visit(k, stamp)) out.push_back(order_[k]);
+    Slot& s = slots_[k];
+    if (s.hx != x || s.hy != y) return;
+    if (overlaps(q, s.box) && s.stamp != stamp) {
+      s.stamp = stamp;
+      out.push_back(s.body);
+    }
+  }
+  // A fresh stamp for one query; the slot at k is new to it when its stamp differs.
+  std::uint32_t next_stamp() {
+    if (++stamp_value_ == 0) {
+      for (Slot& s : slots_) s.stamp = 0;
+      stamp_value_ = 1;
+    }
+    return stamp_value_;
+  }
+  bool first_visit(std::uint32_t k, std::uint32_t stamp) {
+    if (slots_[k].stamp == stamp) return false;
+    slots_[k].stamp = stamp;
+    return true;
   }
 
   double option_cell_ = 0.0;
@@ -311,13 +345,11 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
   double inv_cell_ = 1.0;
   bp_detail::TileHash hash_;
   std::vector<std::uint32_t> start_;    // bucket b holds positions [start_[b], start_[b + 1])
-  std::vector<std::uint32_t> order_;    // body at each position
-  std::vector<std::uint32_t> pos_of_;   // position of each body (its box is boxes_[pos])
+  std::vector<Slot> slots_;             // one per position; boxes_: the boxes as prepared
+  std::vector<std::uint32_t> pos_of_;   // position of each body (its slot)
   std::vector<std::uint32_t> oversize_;
-  std::vector<std::int32_t> home_x_, home_y_;   // home cell of the body at each position
   std::vector<std::uint32_t> extra_head_, extra_next_, extra_body_;
   std::vector<std::uint32_t> extra_used_;   // buckets whose extra_head_ is set
-  std::vector<Aabb> sorted_;                // the boxes' other buffer (build)
 };
 
 }  // namespace

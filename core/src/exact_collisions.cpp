@@ -210,6 +210,7 @@ class EventLoop {
     w_.bp->grow(i, box);
     w_.found.clear();
     w_.bp->query_box(box, i, w_.found);
+    for (std::uint32_t j : w_.found) prefetch_body(j);
     for (std::uint32_t j : w_.found) schedule_pair(i, j, t);
     if (w_.dynamic(i)) schedule_statics(i, t, box);
     schedule_body(i, t);
@@ -228,6 +229,7 @@ class EventLoop {
     w_.bp->grow(j, box_j);
     w_.found.clear();
     w_.bp->query_box(merge(box_i, box_j), kNone, w_.found);
+    for (std::uint32_t k : w_.found) prefetch_body(k);   // all misses at once, not one by one
     for (std::uint32_t k : w_.found) {
       const Aabb& reg_k = w_.bp->box(k);
       if (k != i && overlaps(box_i, reg_k)) schedule_pair(i, k, t);   // includes (i, j)
