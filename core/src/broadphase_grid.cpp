@@ -54,9 +54,14 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     return boxes_;
   }
   const Aabb& box(std::uint32_t i) const override { return slots_[pos_of_[i]].box; }
-  void prefetch(std::uint32_t i) const override {
-    __builtin_prefetch(&pos_of_[i]);
-    __builtin_prefetch(&active_[i]);
+  void prefetch(std::uint32_t i, int level) const override {
+    if (i >= pos_of_.size()) return;
+    if (level == 0) {
+      __builtin_prefetch(&pos_of_[i]);
+      __builtin_prefetch(&active_[i]);
+    } else {
+      __builtin_prefetch(&slots_[pos_of_[i]]);
+    }
   }
 
   void build(std::span<const std::uint8_t> active) override {

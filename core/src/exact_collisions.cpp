@@ -89,6 +89,8 @@ class EventLoop {
     while (!w_.events.empty()) {
       const Event e = w_.events.pop();
       if (const Event* next = w_.events.next()) prefetch(*next);
+      w_.bp->prefetch(e.a, 1);   // its index entry was asked for one event ago
+      if (e.kind() == EventKind::Pair) w_.bp->prefetch(e.b, 1);
       if (!valid(e)) continue;
       if (ctx_.events >= ctx_.event_cap) {
         finish_with_lecture_pass(e.time);
@@ -117,7 +119,7 @@ class EventLoop {
     __builtin_prefetch(&w_.inv_mass[i]);
     __builtin_prefetch(&w_.group[i]);
     __builtin_prefetch(&w_.material[i]);
-    w_.bp->prefetch(i);
+    w_.bp->prefetch(i, 0);
   }
 
   bool valid(const Event& e) const {

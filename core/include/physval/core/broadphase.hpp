@@ -98,8 +98,13 @@ class BroadPhase {
   // The registered box of body i.
   virtual const Aabb& box(std::uint32_t i) const = 0;
 
-  // A hint: body i's entry will be read or grown soon (fetch it into the cache).
-  virtual void prefetch(std::uint32_t i) const { (void)i; }
+  // Hints for a caller that knows what it will touch soon; no effect on answers.
+  // prefetch(i, 0): body i's index entry; prefetch(i, 1): its box (once level 0 has
+  // had time to arrive).
+  virtual void prefetch(std::uint32_t i, int level) const {
+    (void)i;
+    (void)level;
+  }
 
   // Bytes of storage held.
   virtual std::size_t memory_bytes() const = 0;
