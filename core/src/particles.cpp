@@ -48,17 +48,7 @@ void spawn(World& w, EmitterState& e, std::uint16_t emitter, Vec2 p, Vec2 v, dou
   if (!w.mass.empty()) w.mass.push_back(e.def.mass);
   if (!w.angle.empty()) w.angle.push_back(0.0);
   if (!w.fparams.empty()) w.fparams.push_back({});
-  if (w.any_forces) {
-    w.acc.push_back({});
-    w.apath.push_back({});
-    w.support.push_back(kNone);
-    w.support_n.push_back({});
-    w.dep_head.push_back(kNone);
-    w.dep_next.push_back(kNone);
-    w.last_partner.push_back(kNone);
-    w.last_touch.push_back(-INFINITY);
-  }
-  if (w.varying_forces) w.vcorr.push_back({});
+  w.push_force_state();
   w.birth.push_back(birth);
   w.lifetime.push_back(e.def.lifetime);
   w.parent.push_back(parent);

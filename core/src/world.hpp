@@ -219,6 +219,21 @@ struct World {
     return responses[static_cast<std::size_t>(g1) * n_groups + g2];
   }
   PairMaterial pair_material(std::uint16_t m1, std::uint16_t m2) const;
+  // Appends a new body's force and contact state, present only when the scene has
+  // forces (scene bodies at load, particles when they are born).
+  void push_force_state() {
+    if (any_forces) {
+      acc.push_back({});
+      apath.push_back({});
+      support.push_back(kNone);
+      support_n.push_back({});
+      dep_head.push_back(kNone);
+      dep_next.push_back(kNone);
+      last_partner.push_back(kNone);
+      last_touch.push_back(-INFINITY);
+    }
+    if (varying_forces) vcorr.push_back({});
+  }
   // The rest speed for a contact pressed together with normal acceleration a_n.
   double rest_speed(double a_n, double dt) const {
     return rest_speed_option > 0.0 ? rest_speed_option : rest_factor * std::abs(a_n) * dt;

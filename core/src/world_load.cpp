@@ -221,17 +221,7 @@ void load_world(World& w, const Scene& scene) {
       }
       w.fparams.push_back(fp);
     }
-    if (w.any_forces) {
-      w.acc.push_back({});
-      w.apath.push_back({});
-      w.support.push_back(kNone);
-      w.support_n.push_back({});
-      w.dep_head.push_back(kNone);
-      w.dep_next.push_back(kNone);
-      w.last_partner.push_back(kNone);
-      w.last_touch.push_back(-INFINITY);
-    }
-    if (w.varying_forces) w.vcorr.push_back({});
+    w.push_force_state();
     extent = std::max({extent, std::fabs(d.position.x), std::fabs(d.position.y)});
     max_radius = std::max(max_radius, d.radius);
   }

@@ -82,43 +82,6 @@ std::string format_seconds(double s) {
   return buf;
 }
 
-// Runs the engine once, never throwing.
-RunRecord run_once(const Scene& scene, const EngineFactory& engine, const RunOptions& options) {
-  try {
-    return run_engine(scene, engine, options);
-  } catch (const std::exception& e) {
-    RunRecord r;
-    r.scenario = scene.name;
-    r.engine = engine.info.name;
-    r.dt = scene.dt;
-    r.status = RunStatus::Error;
-    r.reason = e.what();
-    return r;
-  } catch (...) {
-    RunRecord r;
-    r.scenario = scene.name;
-    r.engine = engine.info.name;
-    r.dt = scene.dt;
-    r.status = RunStatus::Error;
-    r.reason = "unknown exception";
-    return r;
-  }
-}
-
-RunRecord run_once_isolated(const Scene& scene, const EngineFactory& engine, const RunOptions& options) {
-  try {
-    return run_engine_isolated(scene, engine, options);
-  } catch (const std::exception& e) {
-    RunRecord r;
-    r.scenario = scene.name;
-    r.engine = engine.info.name;
-    r.dt = scene.dt;
-    r.status = RunStatus::Error;
-    r.reason = e.what();
-    return r;
-  }
-}
-
 std::optional<double> metric(const RunRecord& run, const char* name) {
   auto it = run.metrics.find(name);
   if (it == run.metrics.end() || !it->second || !std::isfinite(*it->second)) return std::nullopt;
@@ -147,7 +110,7 @@ void time_point(SweepPoint& p, const Scene& scene, const EngineFactory& engine, 
     long runs = 0;
     const auto start = clock::now();
     do {
-      const RunRecord r = run_once(scene, engine, ro);
+      const RunRecord r = run_engine(scene, engine, ro);
       if (r.status != RunStatus::Ok) {
         p.status = r.status;
         p.reason = "repetition " + std::to_string(rep + 1) + ": " + r.reason;
@@ -305,7 +268,7 @@ SweepResult run_sweep(const Scene& scene, const SweepOptions& options, const Pro
         RunOptions isolated = ro;
         isolated.isolate = true;
         isolated.timeout_seconds = options.timeout_seconds;
-        RunRecord first = run_once_isolated(run_scene, engine, isolated);
+        RunRecord first = run_engine_isolated(run_scene, engine, isolated);
         if (first.status == RunStatus::Ok) {
           try {
             compare_run(first, run_scene, reference, false);
