@@ -76,6 +76,14 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     double sum = 0.0, largest = 0.0;
     std::size_t count = 0;
     double lo_x = std::numeric_limits<double>::infinity(), hi_x = -lo_x, lo_y = lo_x, hi_y = -lo_x;
+    auto extend_centres = [&](const Aabb& b) {
+      const double cx = 0.5 * (static_cast<double>(b.min_x) + b.max_x);
+      const double cy = 0.5 * (static_cast<double>(b.min_y) + b.max_y);
+      lo_x = std::min(lo_x, cx);
+      hi_x = std::max(hi_x, cx);
+      lo_y = std::min(lo_y, cy);
+      hi_y = std::max(hi_y, cy);
+    };
     for (std::size_t i = 0; i < n; ++i) {
       if (!active_[i]) continue;
       const Aabb& b = boxes_[i];
@@ -83,12 +91,7 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
       sum += e;
       largest = std::max(largest, e);
       ++count;
-      const double cx = 0.5 * (static_cast<double>(b.min_x) + b.max_x);
-      const double cy = 0.5 * (static_cast<double>(b.min_y) + b.max_y);
-      lo_x = std::min(lo_x, cx);
-      hi_x = std::max(hi_x, cx);
-      lo_y = std::min(lo_y, cy);
-      hi_y = std::max(hi_y, cy);
+      extend_centres(b);
     }
     const double mean = count > 0 ? sum / static_cast<double>(count) : 0.0;
     double cell = largest;
@@ -106,12 +109,7 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
       for (std::size_t i = 0; i < n; ++i) {
         if (!active_[i] || bp_detail::extent(boxes_[i]) > cell_) continue;
         const Aabb& b = boxes_[i];
-        const double cx = 0.5 * (static_cast<double>(b.min_x) + b.max_x);
-        const double cy = 0.5 * (static_cast<double>(b.min_y) + b.max_y);
-        lo_x = std::min(lo_x, cx);
-        hi_x = std::max(hi_x, cx);
-        lo_y = std::min(lo_y, cy);
-        hi_y = std::max(hi_y, cy);
+        extend_centres(b);
       }
     }
     const bool any = lo_x <= hi_x;
