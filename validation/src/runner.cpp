@@ -223,7 +223,12 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
       }
       const double t = engine->time();
       const bool sampled = (k % every == 0) || k == n;
-      if (sampled && !sample(t)) {
+      if (std::string broken = engine->broken_guarantee(); !broken.empty()) {
+        sample(t);
+        r.status = RunStatus::Diverged;
+        r.reason = std::move(broken);
+        r.diverged_at = t;
+      } else if (sampled && !sample(t)) {
         r.status = RunStatus::Diverged;
         r.reason = "state became NaN or infinite";
         r.diverged_at = t;

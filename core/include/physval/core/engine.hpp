@@ -101,6 +101,12 @@ class Engine {
   // Limits the engine imposed during the run so far (a speed clamp hit, float
   // precision lost far from the origin): one line each, empty when none.
   virtual std::vector<std::string> limits_hit() const { return {}; }
+
+  // A guarantee the engine could not keep during the last step (core: its event cap
+  // was reached, so impacts were no longer resolved exactly and bodies may have passed
+  // through each other). Empty while every guarantee holds. The runner stops the run
+  // at that step and reports it `diverged` with this text and the time.
+  virtual std::string broken_guarantee() const { return {}; }
 };
 
 // The features of `scene` that `info` does not support, by name (empty: it can run).
