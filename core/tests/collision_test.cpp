@@ -138,3 +138,53 @@ TEST(CoreCollision, EventCapFinishesWithLecturePass) {
 }
 
 }  // namespace physval::test
+
+namespace physval::test {
+
+// Galperin's billiard: a light ball between a wall and a ball M/m = 100^k heavier bounces
+// exactly as many times as pi's first k+1 digits (e = 1). At 1e8 that is 31,415 impacts,
+// thousands of them inside single steps near the turning point.
+TEST(CoreCollision, PiBilliardMassRatio1e8FinishesExactlyUnderTheDefaultCap) {
+  const double M = 1e8;
+  Sim sim(scene_of({circle("light", {1.0, 0.0}, {}, 0.1, 1.0), circle("heavy", {2.0, 0.0}, {-1.0, 0.0}, 0.1, M)},
+                   {wall("wall", {0.0, -1.0}, {0.0, 1.0})}));
+  std::int64_t impacts = 0, most_in_a_step = 0;
+  while (sim.engine.time() < 3.0 - 1e-12) {
+    sim.step(0.01);
+    ASSERT_EQ(sim.engine.broken_guarantee(), "") << "t = " << sim.engine.time();
+    impacts += sim.engine.last_step_stats().impacts;
+    most_in_a_step = std::max(most_in_a_step, sim.engine.last_step_stats().impacts);
+  }
+  EXPECT_EQ(impacts, 31415);
+  EXPECT_GT(most_in_a_step, 1000);     // the old default cap (1000 + 100 N) broke here
+  EXPECT_TRUE(sim.engine.limits_hit().empty());
+  // Energy (round-off over 31,415 impacts: 1.9e-12 relative measured) and the final
+  // order: the heavy ball leaves faster than the light one follows.
+  const BodyState l = sim.state("light"), h = sim.state("heavy");
+  EXPECT_NEAR((0.5 * l.velocity.x * l.velocity.x + 0.5 * M * h.velocity.x * h.velocity.x) / (0.5 * M), 1.0, 1e-11);
+  EXPECT_GT(h.velocity.x, 0.0);
+  EXPECT_LE(l.velocity.x, h.velocity.x);
+  EXPECT_LT(l.position.x, h.position.x);   // no pass-through
+}
+
+TEST(CoreCollision, EventCapReachedIsABrokenGuarantee) {
+  // The same billiard with a cap of 500 events: the step that reaches it says so, and a
+  // step that does not leaves broken_guarantee() empty again.
+  EngineOptions opt = options("velocity_verlet");
+  opt["max_events_per_step"] = std::int64_t{500};
+  Sim sim(scene_of({circle("light", {1.0, 0.0}, {}, 0.1, 1.0), circle("heavy", {2.0, 0.0}, {-1.0, 0.0}, 0.1, 1e8)},
+                   {wall("wall", {0.0, -1.0}, {0.0, 1.0})}),
+          opt);
+  sim.step(0.01);
+  EXPECT_EQ(sim.engine.broken_guarantee(), "");
+  bool broke = false;
+  while (!broke && sim.engine.time() < 3.0) {
+    sim.step(0.01);
+    broke = !sim.engine.broken_guarantee().empty();
+  }
+  ASSERT_TRUE(broke);
+  EXPECT_NE(sim.engine.broken_guarantee().find("event cap"), std::string::npos);
+  EXPECT_TRUE(sim.engine.last_step_stats().event_cap_hit);
+}
+
+}  // namespace physval::test
