@@ -73,7 +73,10 @@ void CoreEngine::step(double dt) {
   const bool exact = w.mode == CollisionMode::Exact;
 
   // 1. forces: accelerations at the start of the step
-  if (w.any_forces) core_detail::compute_accelerations(w, w.pos, w.vel, w.acc);
+  if (w.any_forces) {
+    core_detail::forget_old_contacts(w, ctx.t0, dt);
+    core_detail::compute_accelerations(w, w.pos, w.vel, w.acc);
+  }
   // 2. resting contacts: the support takes the normal force; friction along it
   if (w.any_forces && exact) core_detail::apply_supports(w, ctx);
   // 3. integrator: start-of-step kicks and each body's path over the step

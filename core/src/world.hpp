@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <unordered_map>
 #include <limits>
 #include <memory>
 #include <random>
@@ -146,8 +147,9 @@ struct World {
   std::vector<Vec2> support_n;          // unit, from the support towards the body
   std::vector<std::uint32_t> dep_head, dep_next;   // any_forces: bodies resting on each body (a list)
   std::vector<std::uint32_t> released;             // scratch: bodies freed by their support moving
-  std::vector<std::uint32_t> last_partner;   // any_forces: contact continuity
-  std::vector<double> last_touch;
+  // any_forces: contact continuity, per pair: contact_key(i, partner) -> the last time
+  // the pair touched (an impact, or resting on each other at a step's end).
+  std::unordered_map<std::uint64_t, double> last_touch;
   // Names of the scene's bodies, packed: body i is name_chars[name_end[i-1], name_end[i])
   // (particles are named on demand).
   std::string name_chars;
@@ -238,8 +240,6 @@ struct World {
       support_n.push_back({});
       dep_head.push_back(kNone);
       dep_next.push_back(kNone);
-      last_partner.push_back(kNone);
-      last_touch.push_back(-INFINITY);
     }
     if (varying_forces) vcorr.push_back({});
   }
@@ -304,6 +304,12 @@ ImpactResult resolve_static(World& w, std::uint32_t i, Vec2 n, const PairMateria
 void record_contact(World& w, std::uint32_t i, std::uint32_t partner_body, const Segment* seg,
                     double t_abs, double window);
 std::uint32_t static_partner_key(const ObjectRef& owner);
+// The key of a touching pair: body i and a body or a static_partner_key (either order).
+std::uint64_t contact_key(std::uint32_t i, std::uint32_t partner);
+// Marks the pair as touching at time t (a continuing contact, no event).
+void touch_contact(World& w, std::uint32_t i, std::uint32_t partner, double t_abs);
+// Forgets pairs that last touched more than one step before t0 (they cannot continue).
+void forget_old_contacts(World& w, double t0, double dt);
 
 void kill_body(World& w, std::uint32_t i);
 

@@ -187,7 +187,7 @@ void load_world(World& w, const Scene& scene) {
   if (w.newtonian) w.mass.reserve(cap);
   if (any_thrust) w.angle.reserve(cap);
   if (any_drag || any_thrust) w.fparams.reserve(cap);
-  if (w.any_forces) reserve_all(w.acc, w.apath, w.support, w.support_n, w.dep_head, w.dep_next, w.last_partner, w.last_touch);
+  if (w.any_forces) reserve_all(w.acc, w.apath, w.support, w.support_n, w.dep_head, w.dep_next);
   if (w.varying_forces) w.vcorr.reserve(cap);
 
   double extent = 0.0;
@@ -315,7 +315,7 @@ std::size_t World::memory_bytes() const {
   n += bytes_of(flags) + bytes_of(group) + bytes_of(material) + bytes_of(mass) + bytes_of(angle);
   n += bytes_of(acc) + bytes_of(apath) + bytes_of(vcorr) + bytes_of(fparams) + bytes_of(support);
   n += bytes_of(dep_head) + bytes_of(dep_next) + bytes_of(released);
-  n += bytes_of(support_n) + bytes_of(last_partner) + bytes_of(last_touch) + bytes_of(name_end);
+  n += bytes_of(support_n) + last_touch.size() * (sizeof(std::uint64_t) + sizeof(double) + 2 * sizeof(void*)) + bytes_of(name_end);
   n += name_chars.capacity() + 1;
   n += bytes_of(birth) + bytes_of(lifetime) + bytes_of(parent) + bytes_of(emitters);
   n += statics.memory_bytes() + bytes_of(material_table) + bytes_of(responses) + bytes_of(materials);
