@@ -82,6 +82,7 @@ class EventLoop {
     if (!w_.emitters.empty()) {
       w_.scratch_events.clear();
       schedule_explosions(w_, ctx_, w_.scratch_events);
+      schedule_trail_emissions(w_, ctx_, w_.scratch_events);
       for (const Event& e : w_.scratch_events) push(e);
     }
 
@@ -131,7 +132,8 @@ class EventLoop {
       case EventKind::Stop:
       case EventKind::Leave: return w_.version[e.a] == e.va;
       case EventKind::Explode:
-      case EventKind::Expire: return true;
+      case EventKind::Expire:
+      case EventKind::Emit: return true;
     }
     return false;
   }
@@ -305,6 +307,9 @@ class EventLoop {
         w_.advance(e.a, e.time);
         explode_parent(w_, e.b, t_abs);
         free_dependents(e.a, e.time);
+        break;
+      case EventKind::Emit:   // reads the parent's path; its state is not touched
+        record_emission(w_, e.b, w_.pos_at(e.a, e.time), w_.vel_at(e.a, e.time), t_abs);
         break;
     }
   }

@@ -83,6 +83,13 @@ struct EmitterState {
   double next_emit = 0.0;   // trail: absolute time of the next particle
   bool exploded = false;
   std::uint32_t serial = 0;
+  // Trail emissions recorded during the step (exact mode): the parent's position and
+  // velocity at each emission time, spawned at the step's end.
+  struct Emission {
+    Vec2 position, velocity;
+    double time = 0.0;
+  };
+  std::vector<Emission> emitted;
   // An explosion recorded during the step, spawned at its end.
   bool pending = false;
   Vec2 at_position, at_velocity;
@@ -267,6 +274,9 @@ void finish_particles(World& w, const StepContext& ctx);        // particles.cpp
 // kills a parent at its explosion time.
 void schedule_explosions(World& w, const StepContext& ctx, std::vector<Event>& out);
 void explode_parent(World& w, std::uint32_t emitter, double t_abs);
+// Exact mode: an Emit event for each trail particle due in the step, and its record.
+void schedule_trail_emissions(World& w, const StepContext& ctx, std::vector<Event>& out);
+void record_emission(World& w, std::uint32_t emitter, Vec2 position, Vec2 velocity, double t_abs);
 
 // ---- shared pieces
 // Path acceleration of a supported body: the normal component removed and Coulomb
