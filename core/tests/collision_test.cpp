@@ -188,3 +188,34 @@ TEST(CoreCollision, EventCapReachedIsABrokenGuarantee) {
 }
 
 }  // namespace physval::test
+
+namespace physval::test {
+
+TEST(CoreCollision, BodiesTouchingAtTheStart) {
+  // Touching and closing at t = 0: the impact is at t = 0 exactly. Touching and
+  // separating, or touching at rest: nothing happens, no contact.
+  {
+    Sim sim(scene_of({circle("a", {-0.5, 0.0}, {1.0, 0.0}), circle("b", {0.5, 0.0}, {-1.0, 0.0})}));
+    sim.run_until(1.0, 0.01);
+    ASSERT_EQ(sim.contacts.size(), 1u);
+    EXPECT_EQ(sim.contacts[0].time, 0.0);
+    EXPECT_NEAR(sim.state("a").velocity.x, -1.0, 1e-15);
+    EXPECT_NEAR(sim.state("b").velocity.x, 1.0, 1e-15);
+    EXPECT_NEAR(sim.state("a").position.x, -1.5, 1e-12);
+  }
+  {
+    Sim sim(scene_of({circle("a", {-0.5, 0.0}, {-1.0, 0.0}), circle("b", {0.5, 0.0}, {1.0, 0.0})}));
+    sim.run_until(1.0, 0.01);
+    EXPECT_TRUE(sim.contacts.empty());
+    EXPECT_EQ(sim.state("a").velocity.x, -1.0);
+    EXPECT_EQ(sim.state("b").velocity.x, 1.0);
+  }
+  {
+    Sim sim(scene_of({circle("a", {-0.5, 0.0}), circle("b", {0.5, 0.0}), circle("c", {1.5, 0.0})}));
+    sim.run_until(1.0, 0.01);
+    EXPECT_TRUE(sim.contacts.empty());
+    for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(length_squared(sim.state(k).velocity), 0.0);
+  }
+}
+
+}  // namespace physval::test
