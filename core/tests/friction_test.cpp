@@ -157,3 +157,30 @@ TEST(CoreFriction, SlopeGridHoldsOrSlidesExactlyWithNoZeroTimeImpacts) {
 }
 
 }  // namespace physval::test
+
+namespace physval::test {
+
+TEST(CoreFriction, LiftsOffAConvexKinkAndLandsOnTime) {
+  // Frictionless: a small circle slides 1 m down a 20 degree slope to a kink where a 50
+  // degree slope begins. Leaving the first face is an exact event (at sqrt(2 s / a)), and
+  // then it flies: it needs v^2 / r >> g cos to follow the corner, so it leaves along the
+  // first slope and lands on the second where its gap, r (cos 30 - 1) + v t sin 30 -
+  // g cos 50 t^2 / 2, comes back to 0.
+  const double g = 9.8, r = 0.01, s = 1.0, pi = std::acos(-1.0);
+  const double t1 = 20.0 * pi / 180.0, t2 = 50.0 * pi / 180.0;
+  const Vec2 d1{std::cos(t1), -std::sin(t1)}, n1{std::sin(t1), std::cos(t1)};
+  const Vec2 d2{std::cos(t2), -std::sin(t2)};
+  Sim sim(scene_of({circle("ball", -s * d1 + r * n1, {}, r, 1.0, 0.0)},
+                   {wall("upper", -5.0 * d1, {0.0, 0.0}, 0.0), wall("lower", {0.0, 0.0}, 20.0 * d2, 0.0)}, {0.0, -g}));
+  const double a = g * std::sin(t1);
+  const double t_leave = std::sqrt(2.0 * s / a), v = a * t_leave;
+  const double A = -0.5 * g * std::cos(t2), B = v * std::sin(pi / 6.0), C = r * (std::cos(pi / 6.0) - 1.0);
+  const double t_fly = (-B - std::sqrt(B * B - 4.0 * A * C)) / (2.0 * A);
+  sim.run_until(t_leave + t_fly + 0.5, 1.0 / 60.0);
+  double landing = -1.0;
+  for (const ContactEvent& c : sim.contacts)
+    if (c.b.kind != ObjectRef::Kind::Body && c.b.index == 1u && landing < 0.0) landing = c.time;
+  EXPECT_NEAR(landing, t_leave + t_fly, 1e-9);
+}
+
+}  // namespace physval::test
