@@ -219,3 +219,30 @@ TEST(CoreCollision, BodiesTouchingAtTheStart) {
 }
 
 }  // namespace physval::test
+
+namespace physval::test {
+
+TEST(CoreCollision, GalperinBilliardCountsAtEveryMassRatioUpTo1e10) {
+  // A light ball between a wall and a heavy one (e = 1) collides N times in all, N the
+  // largest n with n atan(sqrt(m / M)) < pi (Galperin): 314 at 1e4, 3,141 at 1e6,
+  // 99,345 at 1e9, 314,159 at 1e10. Every impact must be resolved, under the default
+  // event cap, whatever the step.
+  for (double M : {1e4, 1e6, 1e9, 1e10}) {
+    SCOPED_TRACE(M);
+    const long double theta = std::atan(std::sqrt(1.0L / static_cast<long double>(M)));
+    const auto expected = static_cast<std::int64_t>(std::ceil(std::acos(-1.0L) / theta)) - 1;
+    Sim sim(scene_of({circle("light", {1.0, 0.0}, {}, 0.1, 1.0), circle("heavy", {2.0, 0.0}, {-1.0, 0.0}, 0.1, M)},
+                     {wall("wall", {0.0, -1.0}, {0.0, 1.0})}));
+    // Long enough for the last, slow return of the light ball from the wall.
+    std::int64_t impacts = 0;
+    while (sim.engine.time() < 200.0 - 1e-9) {
+      sim.step(0.05);
+      ASSERT_EQ(sim.engine.broken_guarantee(), "");
+      impacts += sim.engine.last_step_stats().impacts;
+    }
+    EXPECT_EQ(impacts, expected);
+    EXPECT_LT(sim.state("light").position.x, sim.state("heavy").position.x);
+  }
+}
+
+}  // namespace physval::test
