@@ -135,6 +135,8 @@ std::vector<Setting> CoreEngine::settings() const {
   std::vector<Setting> s;
   s.emplace_back("integrator", core_detail::integrator_name(w.integrator));
   s.emplace_back("collision", w.mode == CollisionMode::Exact ? "exact" : "lecture");
+  s.emplace_back("impact_law",
+                 w.impact_law == core_detail::ImpactLaw::Simultaneous ? "simultaneous" : "sequential");
   s.emplace_back("broadphase", std::string(broadphase_name(w.broadphase)) + (w.broadphase_auto ? " (auto)" : ""));
   s.emplace_back("cell_size", w.cell_size > 0.0 ? option_value_to_string(w.cell_size) : "auto");
   s.emplace_back("max_events_per_step",

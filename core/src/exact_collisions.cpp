@@ -356,6 +356,10 @@ class EventLoop {
         }
       }
     }
+    if (!settled && min_sep == 0.0 && resolve_simultaneous(w_, i, j, t, set_, impacted_)) {
+      finish_simultaneous(t, t_abs);
+      return;
+    }
     if (!settled) {
       resolve_pair(w_, i, j, n, m, min_sep);
       after_velocity_change(i);
@@ -370,6 +374,23 @@ class EventLoop {
     if (!settled) {
       free_dependents(i, t);
       free_dependents(j, t);
+    }
+  }
+
+  // Every body of a touching set resolved at once (resolve_simultaneous): new paths
+  // for all, contacts recorded per pair that took an impulse, dependents freed.
+  void finish_simultaneous(double t, double t_abs) {
+    for (std::uint32_t b : set_) {
+      if (w_.is_static(b)) continue;
+      after_velocity_change(b);
+      ++w_.version[b];
+    }
+    for (const BodyPair& p : impacted_) record_contact(w_, p.a, p.b, nullptr, t_abs, ctx_.dt);
+    for (std::uint32_t b : set_) {
+      if (!w_.is_static(b)) reschedule(b, t);
+    }
+    for (std::uint32_t b : set_) {
+      if (!w_.is_static(b)) free_dependents(b, t);
     }
   }
 
@@ -459,6 +480,8 @@ class EventLoop {
   World& w_;
   StepContext& ctx_;
   const double T_;
+  std::vector<std::uint32_t> set_;      // the touching set of a simultaneous impact
+  std::vector<BodyPair> impacted_;      // its pairs that took an impulse
 };
 
 }  // namespace

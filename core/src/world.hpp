@@ -23,6 +23,7 @@ namespace physval::core_detail {
 
 enum class Integrator : std::uint8_t { ExplicitEuler, SemiImplicitEuler, VelocityVerlet, Rk4 };
 enum class CollisionMode : std::uint8_t { Exact, Lecture };
+enum class ImpactLaw : std::uint8_t { Simultaneous, Sequential };
 const char* integrator_name(Integrator i);
 
 inline constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
@@ -116,6 +117,7 @@ struct World {
   // ---- settings (EngineInfo options, after defaults)
   Integrator integrator = Integrator::VelocityVerlet;
   CollisionMode mode = CollisionMode::Exact;
+  ImpactLaw impact_law = ImpactLaw::Simultaneous;
   BroadPhaseKind broadphase = BroadPhaseKind::Grid;
   bool broadphase_auto = true;
   double cell_size = 0.0;
@@ -307,6 +309,13 @@ struct ImpactResult {
 };
 ImpactResult resolve_pair(World& w, std::uint32_t i, std::uint32_t j, Vec2 n, const PairMaterial& m,
                           double min_separation_speed);
+// Simultaneous impacts (simultaneous_impacts.cpp): if the pair (i, j) impacting at t
+// belongs to a touching set of two or more contacts, solves Newton's law on all of
+// them at once, leaves every body of the set advanced to t in `bodies` and the pairs
+// that took an impulse in `impacted`, returns true.
+// Otherwise (one contact, sequential law, friction, supports, rules) changes nothing.
+bool resolve_simultaneous(World& w, std::uint32_t i, std::uint32_t j, double t, std::vector<std::uint32_t>& bodies,
+                          std::vector<BodyPair>& impacted);
 ImpactResult resolve_static(World& w, std::uint32_t i, Vec2 n, const PairMaterial& m,
                             double min_separation_speed);
 // Records a contact event if the contact begins (see exact_collisions.cpp) at absolute

@@ -31,6 +31,10 @@ std::vector<OptionSpec> core_option_specs() {
                "exact: event-driven, advances to each impact in turn within the step; "
                "lecture: move all, find overlaps at the end of the step, back each up to its "
                "interpolated time of impact, reflect, finish the step (one pass)"});
+  s.push_back({"impact_law", std::string("simultaneous"), {"simultaneous", "sequential"},
+               "exact mode, impacts at the same time (to round-off) that share a body: simultaneous: "
+               "Newton's restitution law at every touching contact at once (independent of body "
+               "numbering); sequential: one pair at a time in body order (the lecture's answer)"});
   s.push_back({"broadphase", std::string("auto"), {"auto", "all_pairs", "grid", "multigrid", "sort_and_sweep"},
                "broad phase; all give the same pairs. auto: all_pairs below 64 bodies, grid for "
                "similar sizes, multigrid for a moderate spread of sizes, sort_and_sweep beyond"});
@@ -129,6 +133,10 @@ void read_options(World& w, const Scene& scene) {
   if (coll == "exact") w.mode = CollisionMode::Exact;
   else if (coll == "lecture") w.mode = CollisionMode::Lecture;
   else throw std::invalid_argument("core: unknown collision mode '" + coll + "'");
+  const std::string law = opt.get_string("impact_law");
+  if (law == "simultaneous") w.impact_law = ImpactLaw::Simultaneous;
+  else if (law == "sequential") w.impact_law = ImpactLaw::Sequential;
+  else throw std::invalid_argument("core: unknown impact_law '" + law + "'");
   const std::string bp = opt.get_string("broadphase");
   w.broadphase_auto = bp == "auto";
   if (!w.broadphase_auto && !parse_broadphase(bp, w.broadphase)) {

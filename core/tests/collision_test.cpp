@@ -105,10 +105,11 @@ TEST(CoreCollision, LectureModeTunnelsWhereExactDoesNot) {
 
 TEST(CoreCollision, NewtonsCradlePassesMomentumThrough) {
   // Ball 0 at 1 m/s meets four touching balls at t = 1: four impacts at the same
-  // instant, resolved in turn; the last ball leaves at 1 m/s, the others stop.
+  // instant, resolved in turn (impact_law = "sequential"); the last ball leaves at
+  // 1 m/s, the others stop. The simultaneous law: simultaneous_impact_test.cpp.
   std::vector<BodyDef> balls = {circle("b0", {-2.0, 0.0}, {1.0, 0.0})};
   for (int k = 1; k <= 4; ++k) balls.push_back(circle("b" + std::to_string(k), {static_cast<double>(k - 1), 0.0}));
-  Sim sim(scene_of(balls));
+  Sim sim(scene_of(balls), {{"impact_law", std::string("sequential")}});
   sim.run_until(2.0, 1.0 / 60.0);
   for (int k = 0; k < 4; ++k) EXPECT_NEAR(sim.state(static_cast<std::size_t>(k)).velocity.x, 0.0, 1e-12) << k;
   EXPECT_NEAR(sim.state(4).velocity.x, 1.0, 1e-12);
@@ -119,12 +120,13 @@ TEST(CoreCollision, NewtonsCradlePassesMomentumThrough) {
 }
 
 TEST(CoreCollision, EventCapFinishesWithLecturePass) {
-  // Cap at 2 events: the cradle needs 4 at one instant. The step finishes with the
-  // lecture pass instead of stalling, and the run says so.
+  // Cap at 2 events: the cradle needs 4 at one instant under the sequential law. The
+  // step finishes with the lecture pass instead of stalling, and the run says so.
   std::vector<BodyDef> balls = {circle("b0", {-2.0, 0.0}, {1.0, 0.0})};
   for (int k = 1; k <= 4; ++k) balls.push_back(circle("b" + std::to_string(k), {static_cast<double>(k - 1), 0.0}));
   EngineOptions opt = options("velocity_verlet");
   opt["max_events_per_step"] = std::int64_t{2};
+  opt["impact_law"] = std::string("sequential");
   Sim sim(scene_of(balls), opt);
   sim.run_until(3.0, 1.0 / 60.0);
   EXPECT_FALSE(sim.engine.limits_hit().empty());
