@@ -354,6 +354,17 @@ void compare_run(RunRecord& run, const Scene& scene, const Reference& reference,
     if (metric == "expectation_failures") continue;
     add_check(run, metric, limit, run.metrics[metric], enforce_gates);
   }
+  // A gate that checks nothing is not a pass: a scenario without [gate] limits and
+  // without [expect] fails `physval gate` (the run's own status still shows in `run`).
+  if (enforce_gates && limits.empty() && scene.expect.empty()) {
+    Check c;
+    c.what = "nothing_checked (the scenario has no [gate] limit and no [expect])";
+    c.limit = 0.0;
+    c.value = std::nullopt;
+    c.pass = false;
+    c.enforced = true;
+    run.checks.push_back(c);
+  }
 }
 
 PairComparison compare_pair(const RunRecord& a, const RunRecord& b, const Scene& scene) {

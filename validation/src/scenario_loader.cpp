@@ -537,13 +537,25 @@ void read_engine_options(Context& ctx, const toml::table& t, const EngineInfo& i
         break;
       case 1:
         if (const auto* i = n->as_integer()) {
-          out[spec.key] = static_cast<std::int64_t>(i->get());
+          const auto v = static_cast<std::int64_t>(i->get());
+          if (!spec.range.contains(static_cast<double>(v))) {
+            r.error_at(*n, spec.key, "must be " + spec.range.describe() + ", got " + std::to_string(v));
+            break;
+          }
+          out[spec.key] = v;
         } else {
           r.error_at(*n, spec.key, std::string("expected an integer, got ") + type_name(*n));
         }
         break;
       case 2:
-        if (auto v = r.to_number(*n, kp)) out[spec.key] = *v;
+        if (auto v = r.to_number(*n, kp)) {
+          if (!std::isfinite(*v) || !spec.range.contains(*v)) {
+            r.error_at(*n, spec.key, "must be a finite number " + spec.range.describe() + ", got " +
+                                         option_value_to_string(OptionValue{*v}));
+            break;
+          }
+          out[spec.key] = *v;
+        }
         break;
       default: {
         std::string s;
@@ -642,6 +654,12 @@ Scene read_scene(Context& ctx, const toml::table& root) {
   r.read_required("duration", s.duration, "> 0", [](double v) { return v > 0.0; });
   r.read("dt", s.dt, "> 0", [](double v) { return v > 0.0; });
   r.read("sample_interval", s.sample_interval, ">= 0", [](double v) { return v >= 0.0; });
+  if (s.duration > 0.0 && s.dt > 0.0) {
+    if (const std::string too_many = scene_steps_error(s); !too_many.empty()) {
+      const toml::node* at = root.get("dt") != nullptr ? root.get("dt") : root.get("duration");
+      if (at != nullptr) r.error_at(*at, root.get("dt") != nullptr ? "dt" : "duration", too_many);
+    }
+  }
   if (const toml::node* n = r.node("engines")) {
     const auto* a = n->as_array();
     if (a == nullptr) {

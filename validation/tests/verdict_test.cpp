@@ -1,0 +1,152 @@
+// Wrong greens (issue 10): a verdict that checked nothing, or measured the wrong thing,
+// must not pass. Each test here failed before its fix.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int status = -1;
+  std::string output;   // stdout and stderr
+};
+
+Result physval(const std::string& args) {
+  Result r;
+  const std::string cmd = std::string(PHYSVAL_EXE) + " " + args + " 2>&1";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (p == nullptr) return r;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
+  const int w = ::pclose(p);
+  r.status = WIFEXITED(w) ? WEXITSTATUS(w) : -1;
+  return r;
+}
+
+bool has(const Result& r, const std::string& text) { return r.output.find(text) != std::string::npos; }
+
+class Verdict : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("physval_verdict_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path write(const std::string& name, const std::string& text) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p;
+  }
+  std::string out() const { return " --quiet --out " + (dir_ / "out").string(); }
+  fs::path dir_;
+};
+
+// One ball falling onto the floor, on core only; the gate is whatever the test appends.
+const std::string kDrop = R"(name = "drop"
+duration = 0.5
+dt = 0.01
+engines = ["core"]
+
+[world]
+gravity = [0.0, -9.81]
+
+[[bodies]]
+name = "ball"
+radius = 0.5
+mass = 1.0
+position = [0.0, 5.0]
+)";
+
+// Item 1: ceil(duration / dt) wrapped past 2^31 to a negative count and ran 0 steps, green.
+TEST_F(Verdict, StepCountPastTheLimitIsRefusedNotWrapped) {
+  const fs::path f = write("tiny_dt.toml", "name = \"tiny\"\nduration = 1.0\ndt = 2e-10\n"
+                                           "[[bodies]]\nname = \"a\"\nradius = 0.5\nposition = [0, 0]\n");
+  const Result r = physval("check " + f.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_TRUE(has(r, f.string() + ":3:")) << r.output;
+  EXPECT_TRUE(has(r, "dt")) << r.output;
+  EXPECT_TRUE(has(r, "more than physval runs")) << r.output;
+  EXPECT_FALSE(has(r, "-2147483648")) << r.output;
+
+  const fs::path drop = write("drop.toml", kDrop + "[gate]\nenergy_drift = 1\n");
+  const Result g = physval("gate " + drop.string() + " --duration 1e9" + out());
+  EXPECT_EQ(g.status, 2) << g.output;
+  EXPECT_TRUE(has(g, "more than physval runs")) << g.output;
+}
+
+// Item 6: out-of-range engine options passed `check`, then failed `run` without a
+// location, or ran (Bullet's ball fell through the floor).
+TEST_F(Verdict, CheckRejectsEngineOptionsOutOfRange) {
+  const std::string head = "name = \"k\"\nduration = 1.0\n[[bodies]]\nname = \"a\"\nradius = 0.5\nposition = [0, 0]\n";
+  struct Case {
+    std::string table, key, value;
+  };
+  const std::vector<Case> cases = {{"box2d", "velocity_iterations", "-1"},
+                                   {"core", "max_events_per_step", "-1"},
+                                   {"bullet", "contact_processing_threshold", "-1"},
+                                   {"bullet", "erp", "1.5"},
+                                   {"bullet", "solver_iterations", "0"},
+                                   {"core", "cell_size", "nan"}};
+  for (const Case& c : cases) {
+    const fs::path f = write(c.table + "_" + c.key + ".toml", head + "[" + c.table + "]\n" + c.key + " = " + c.value + "\n");
+    const Result r = physval("check " + f.string());
+    EXPECT_EQ(r.status, 2) << c.key << ": " << r.output;
+    EXPECT_TRUE(has(r, f.string() + ":8:")) << c.key << ": " << r.output;
+    EXPECT_TRUE(has(r, c.table + "." + c.key)) << c.key << ": " << r.output;
+  }
+  // In range still passes.
+  const fs::path ok = write("ok.toml", head + "[box2d]\nvelocity_iterations = 1\n[bullet]\nerp = 1.0\n");
+  EXPECT_EQ(physval("check " + ok.string()).status, 0);
+}
+
+// Item 3: gates that checked nothing.
+TEST_F(Verdict, GateWithoutLimitsOrExpectationsFails) {
+  const fs::path f = write("drop.toml", kDrop);
+  const Result r = physval("gate " + f.string() + out());
+  EXPECT_EQ(r.status, 1) << r.output;
+  // `run` is not a gate: the same scenario runs fine.
+  EXPECT_EQ(physval("run " + f.string() + out()).status, 0);
+}
+
+TEST_F(Verdict, GateWithNoRunFails) {
+  const fs::path f = write("drop.toml", kDrop + "[gate]\nenergy_drift = 1\n");
+  const Result r = physval("gate --engines box2d" + out() + " " + f.string());
+  EXPECT_EQ(r.status, 1) << r.output;
+  EXPECT_TRUE(has(r, "nothing was checked")) << r.output;
+}
+
+TEST_F(Verdict, NanFlagsAreBadInput) {
+  const fs::path f = write("drop.toml", kDrop + "[gate]\nenergy_drift = 1\n");
+  const Result b = physval("gate " + f.string() + out() + " --baseline " + f.string() + " --baseline-factor nan");
+  EXPECT_EQ(b.status, 2) << b.output;
+  const Result t = physval("gate " + f.string() + out() + " --timeout nan");
+  EXPECT_EQ(t.status, 2) << t.output;
+  EXPECT_TRUE(has(t, "--timeout")) << t.output;
+}
+
+TEST_F(Verdict, BaselineThatMatchesNoRunOrAnotherDtFails) {
+  const fs::path f = write("drop.toml", kDrop + "[gate]\nenergy_drift = 1\n");
+  const fs::path empty = write("empty.json", R"({"runs": []})");
+  const Result none = physval("gate " + f.string() + out() + " --baseline " + empty.string());
+  EXPECT_EQ(none.status, 2) << none.output;
+  EXPECT_TRUE(has(none, "matches no run")) << none.output;
+
+  const fs::path other = write("other.json", R"({"runs": [{"scenario": "drop", "engine": "core", "dt": 0.001,
+                                                           "metrics": {"energy_drift": 1.0}}]})");
+  const Result dt = physval("gate " + f.string() + out() + " --baseline " + other.string());
+  EXPECT_EQ(dt.status, 1) << dt.output;
+}
+
+}  // namespace
