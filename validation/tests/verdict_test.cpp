@@ -150,3 +150,26 @@ TEST_F(Verdict, BaselineThatMatchesNoRunOrAnotherDtFails) {
 }
 
 }  // namespace
+
+namespace {
+
+// Item 7: bodies overlapping at t = 0 were accepted silently.
+TEST_F(Verdict, InitialOverlapIsAnErrorUnlessOptedIn) {
+  const std::string two = "[[bodies]]\nname = \"a\"\nradius = 0.5\nposition = [0, 0]\n"
+                          "[[bodies]]\nname = \"b\"\nradius = 0.5\nposition = [0.9, 0]\n";   // lines 3-10
+  const fs::path f = write("overlap.toml", "name = \"o\"\nduration = 1.0\n" + two);
+  const Result r = physval("check " + f.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_TRUE(has(r, f.string() + ":10:")) << r.output;
+  EXPECT_TRUE(has(r, "bodies[1].position")) << r.output;
+  EXPECT_TRUE(has(r, "overlaps body \"a\"")) << r.output;
+
+  const fs::path opt = write("opt.toml", "name = \"o\"\nduration = 1.0\nallow_initial_overlap = true\n" + two);
+  EXPECT_EQ(physval("check " + opt.string()).status, 0);
+  // Touching is not overlapping.
+  const fs::path touch = write("touch.toml", "name = \"t\"\nduration = 1.0\n[[bodies]]\nname = \"a\"\nradius = 0.5\n"
+                                             "position = [0, 0]\n[[bodies]]\nname = \"b\"\nradius = 0.5\nposition = [1, 0]\n");
+  EXPECT_EQ(physval("check " + touch.string()).status, 0);
+}
+
+}  // namespace
