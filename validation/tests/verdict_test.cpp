@@ -173,3 +173,35 @@ TEST_F(Verdict, InitialOverlapIsAnErrorUnlessOptedIn) {
 }
 
 }  // namespace
+
+namespace {
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Item 2: the reference's convergence limit scaled with the scene's extent, so one body
+// parked 1e7 m away made the chaotic gas's reference "converged" (limit ~10 m).
+TEST_F(Verdict, AFarBodyDoesNotLoosenAnotherBodysConvergenceLimit) {
+  std::string gas = read_text(fs::path(PHYSVAL_SCENARIO_DIR) / "models" / "circle_gas.toml");
+  const std::size_t walls = gas.find("[[walls]]");
+  const std::size_t gate = gas.find("[gate");
+  ASSERT_NE(walls, std::string::npos);
+  ASSERT_NE(gate, std::string::npos);
+  const std::string far = "[[bodies]]\nname = \"far\"\nradius = 0.05\nposition = [1e7, 0.0]\n\n";
+  const std::string base = gas.substr(0, gate);
+  const std::string with_far = gas.substr(0, walls) + far + gas.substr(walls, gate - walls);
+  for (const auto& [name, text] : {std::pair{"gas", base}, std::pair{"gas_far", with_far}}) {
+    const fs::path f = write(std::string(name) + ".toml", text + "[gate]\nenergy_drift = 1\n");
+    const fs::path o = dir_ / name;
+    const Result r = physval("run --engines core --quiet --out " + o.string() + " " + f.string());
+    ASSERT_NE(r.status, 2) << r.output;
+    const std::string results = read_text(o / "results.json");
+    // Not converged, with or without the far body, and the reason names a gas body.
+    EXPECT_NE(results.find("\"converged\": false"), std::string::npos) << name;
+    EXPECT_EQ(results.find("\"converged\": true"), std::string::npos) << name;
+  }
+}
+
+}  // namespace
