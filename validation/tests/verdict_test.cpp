@@ -205,3 +205,59 @@ TEST_F(Verdict, AFarBodyDoesNotLoosenAnotherBodysConvergenceLimit) {
 }
 
 }  // namespace
+
+#include "physval/validation/comparator.hpp"
+
+namespace {
+
+// Item 8: a body destroyed exactly at a sample time, with the two runs' clocks on either
+// side of it, made an energy divergence of 0.75 between runs whose positions agree.
+TEST(VerdictCompare, DestructionAtASampleTimeIsNotAnEnergyDivergence) {
+  physval::Scene scene;
+  scene.name = "destroy";
+  scene.dt = 0.1;
+  scene.duration = 0.3;
+  scene.bodies.resize(2);
+  scene.bodies[0].name = "keep";
+  scene.bodies[0].radius = 0.5;
+  scene.bodies[0].velocity = {1.0, 0.0};
+  scene.bodies[1].name = "gone";
+  scene.bodies[1].radius = 0.5;
+  scene.bodies[1].position = {5.0, 0.0};
+  scene.bodies[1].velocity = {1.0, 0.0};
+  auto record = [&](const std::string& engine, double clock_offset, bool gone_at_sample_1, bool gone_at_sample_2) {
+    physval::RunRecord r;
+    r.engine = engine;
+    r.dt = 0.1;
+    for (int k = 0; k < 4; ++k) {
+      const double t = 0.1 * k + (k == 1 ? clock_offset : 0.0);
+      const bool gone = (k == 1 && gone_at_sample_1) || (k >= 2 && gone_at_sample_2);
+      physval::BodyState a{{t, 0.0}, {1.0, 0.0}};
+      physval::BodyState b{{5.0 + t, 0.0}, {1.0, 0.0}};
+      b.alive = !gone;
+      r.series.time.push_back(t);
+      r.series.states.push_back({a, b});
+      physval::Totals tot;
+      tot.kinetic = gone ? 0.5 : 1.0;
+      tot.momentum = {gone ? 1.0 : 2.0, 0.0};
+      r.series.totals.push_back(tot);
+    }
+    return r;
+  };
+  // Destroyed at t = 0.1: one clock a hair past it (gone), the other a hair before (alive).
+  const physval::RunRecord a = record("a", 1e-13, true, true);
+  const physval::RunRecord b = record("b", -1e-13, false, true);
+  const physval::PairComparison same = physval::compare_pair(a, b, scene);
+  ASSERT_TRUE(same.metrics.at("energy_divergence").has_value());
+  EXPECT_LT(*same.metrics.at("energy_divergence"), 1e-12);
+  ASSERT_TRUE(same.metrics.at("position_divergence").has_value());
+  EXPECT_LT(*same.metrics.at("position_divergence"), 1e-12);
+
+  // A destruction that really differs (b never destroys it) is still an energy divergence.
+  const physval::RunRecord never = record("c", 0.0, false, false);
+  const physval::PairComparison differs = physval::compare_pair(a, never, scene);
+  ASSERT_TRUE(differs.metrics.at("energy_divergence").has_value());
+  EXPECT_GT(*differs.metrics.at("energy_divergence"), 0.1);
+}
+
+}  // namespace
