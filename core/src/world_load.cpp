@@ -39,15 +39,18 @@ std::vector<OptionSpec> core_option_specs() {
                "broad phase; all give the same pairs. auto: all_pairs below 64 bodies, grid for "
                "similar sizes, multigrid for a moderate spread of sizes, sort_and_sweep beyond"});
   s.push_back({"cell_size", 0.0, {},
-               "grid cell edge in m (grid: a lower bound; multigrid: the edge); 0 picks it from the bodies"});
+               "grid cell edge in m (grid: a lower bound; multigrid: the edge); 0 picks it from the bodies",
+       OptionRange::at_least(0)});
   s.push_back({"max_events_per_step", std::int64_t{0}, {},
                "exact mode: events one step may process; at the cap the rest of the step is finished "
-               "by the lecture pass, impacts are no longer exact and the run stops as diverged. "
-               "0: 1,000,000 + 100 per body"});
+                "by the lecture pass, impacts are no longer exact and the run stops as diverged. "
+                "0: 1,000,000 + 100 per body",
+        OptionRange::between(0, 1e9)});
   s.push_back({"rest_speed", 0.0, {},
                "m/s: an impact against a surface the body is pressed into, leaving slower than this, "
                "settles into resting contact. 0: |a_n| dt / 16 (velocity_verlet, rk4) or 1.5 |a_n| dt "
-               "(Euler integrators)"});
+               "(Euler integrators)",
+       OptionRange::at_least(0)});
   return s;
 }
 
