@@ -79,36 +79,56 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
                           std::vector<std::uint32_t>& bodies, std::vector<BodyPair>& impacted) {
   if (w.impact_law != ImpactLaw::Simultaneous || w.any_rules) return false;
   if (!eligible_body(w, i0) || !eligible_body(w, j0)) return false;
-  std::vector<Contact> contacts;
+  // Scratch kept between calls: an isolated impact (the common case) allocates nothing.
+  thread_local std::vector<Contact> contacts;
+  thread_local std::vector<std::uint32_t> found;
+  thread_local std::vector<double> A, w0;
+  contacts.clear();
   bodies.clear();
   bodies.push_back(std::min(i0, j0));
   bodies.push_back(std::max(i0, j0));
-  std::vector<std::uint32_t> found;
-  // Breadth-first over the touching set; static bodies end it (nothing moves them).
-  for (std::size_t q = 0; q < bodies.size(); ++q) {
+  // Adds contact (i, j) if the two touch; false if the set must go pair by pair.
+  const auto consider = [&](std::uint32_t i, std::uint32_t j) {
+    if (j == i || !eligible_body(w, j)) return true;
+    if (w.is_static(i) && w.is_static(j)) return true;
+    Contact c;
+    if (!touching(w, i, j, t, c)) return true;
+    const bool known = std::any_of(contacts.begin(), contacts.end(),
+                                   [&](const Contact& k) { return k.a == c.a && k.b == c.b; });
+    if (known) return true;
+    const PairMaterial m = w.pair_material(w.material[c.a], w.material[c.b]);
+    if (m.friction > 0.0 || m.static_friction > 0.0) return false;
+    const double wn = dot(w.vel_at(c.b, t) - w.vel_at(c.a, t), c.n);
+    c.target = std::max(-m.restitution * wn, 0.0);
+    contacts.push_back(c);
+    if (contacts.size() > kMaxContacts) return false;
+    if (std::find(bodies.begin(), bodies.end(), j) == bodies.end()) bodies.push_back(j);
+    return true;
+  };
+  const auto touch_box = [&](std::uint32_t i) {
+    const Vec2 p = w.pos_at(i, t);
+    const double pad = kGapUlps * kEps * (inf_norm(p) + 2.0 * w.radius[i] + 1.0) + w.radius[i];
+    return make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad);
+  };
+  // The impacting pair first, with one broad-phase query for both (an isolated impact,
+  // the common case, pays only this); then breadth-first over the rest of the set.
+  // Static bodies end the set (nothing moves them).
+  const std::uint32_t first = bodies[0], second = bodies[1];
+  found.clear();
+  w.bp->query_box(merge(touch_box(first), touch_box(second)), kNone, found);
+  std::sort(found.begin(), found.end());
+  for (std::uint32_t j : found) {
+    if (!w.is_static(first) && !consider(first, j)) return false;
+    if (!w.is_static(second) && !consider(second, j)) return false;
+  }
+  for (std::size_t q = 2; q < bodies.size(); ++q) {
     const std::uint32_t i = bodies[q];
     if (w.is_static(i)) continue;
-    const Vec2 p = w.pos_at(i, t);
-    const double r = w.radius[i];
-    const double pad = kGapUlps * kEps * (inf_norm(p) + 2.0 * r + 1.0) + r;
     found.clear();
-    w.bp->query_box(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), i, found);
+    w.bp->query_box(touch_box(i), i, found);
     std::sort(found.begin(), found.end());
     for (std::uint32_t j : found) {
-      if (j == i || !eligible_body(w, j)) continue;
-      if (w.is_static(i) && w.is_static(j)) continue;
-      Contact c;
-      if (!touching(w, i, j, t, c)) continue;
-      const bool known = std::any_of(contacts.begin(), contacts.end(),
-                                     [&](const Contact& k) { return k.a == c.a && k.b == c.b; });
-      if (known) continue;
-      const PairMaterial m = w.pair_material(w.material[c.a], w.material[c.b]);
-      if (m.friction > 0.0 || m.static_friction > 0.0) return false;
-      const double wn = dot(w.vel_at(c.b, t) - w.vel_at(c.a, t), c.n);
-      c.target = std::max(-m.restitution * wn, 0.0);
-      contacts.push_back(c);
-      if (contacts.size() > kMaxContacts) return false;
-      if (std::find(bodies.begin(), bodies.end(), j) == bodies.end()) bodies.push_back(j);
+      if (!consider(i, j)) return false;
     }
   }
   if (contacts.size() < 2) return false;   // one contact: the pairwise law is the same
@@ -116,7 +136,8 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   for (std::uint32_t b : bodies) w.advance(b, t);
   // Delassus matrix, dense (the set is small).
   const std::size_t K = contacts.size();
-  std::vector<double> A(K * K, 0.0), w0(K);
+  A.assign(K * K, 0.0);
+  w0.assign(K, 0.0);
   for (std::size_t k = 0; k < K; ++k) {
     const Contact& ck = contacts[k];
     w0[k] = dot(w.vel[ck.b] - w.vel[ck.a], ck.n);

@@ -88,6 +88,11 @@ void register_all() {
         for (const char* mode : {"exact", "lecture"}) {
           register_one("gas/core_" + std::string(mode), &f, {{"collision", std::string(mode)}}, n);
         }
+        // What the simultaneous-impact law costs: the same exact run with the pairwise law.
+        if (n <= 10000) {
+          register_one("gas/core_exact_sequential", &f,
+                       {{"collision", std::string("exact")}, {"impact_law", std::string("sequential")}}, n);
+        }
       } else if (n <= 10000) {
         // Box2D takes over 1 s per step and Bullet about 0.5 s at 100k: stop at 10k.
         register_one("gas/" + f.info.name, &f, {}, n);
