@@ -297,8 +297,55 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
   return os.str();
 }
 
-void render_png(const Figure& figure, const fs::path& png) {
-  if (!gnuplot_available()) {
+namespace {
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void write_data(const Figure& figure, std::ostream& data) {
+  for (const Panel& panel : figure.panels) {
+    for (const Series& s : panel.series) {
+      const auto points = drawable(s, panel);
+      if (points.empty()) continue;
+      for (const auto& pt : points) {
+        if (is_gap(pt)) {
+          data << "\n";   // one blank line: a break in the line, same block
+          continue;
+        }
+        char line[80];
+        std::snprintf(line, sizeof line, "%.17g %.17g\n", pt.first, pt.second);
+        data << line;
+      }
+      data << "\n\n";   // two blank lines end a gnuplot `index` block
+    }
+  }
+}
+
+// Runs gnuplot once on `script`, its messages into `log`; whether it exited 0.
+bool run_gnuplot(const fs::path& script, const fs::path& log) {
+  const std::string command = "gnuplot " + shell_quoted(script.string()) + " >" + shell_quoted(log.string()) + " 2>&1";
+  const int rc = std::system(command.c_str());
+  return rc != -1 && WIFEXITED(rc) && WEXITSTATUS(rc) == 0;
+}
+
+// Into place whole: copy next to the target, then rename over it.
+void move_into_place(const fs::path& from, const fs::path& png) {
+  if (png.has_parent_path()) fs::create_directories(png.parent_path());
+  const fs::path staged = png.string() + ".tmp";
+  fs::copy_file(from, staged, fs::copy_options::overwrite_existing);
+  fs::rename(staged, png);
+}
+
+}  // namespace
+
+std::vector<std::string> render_pngs(const std::vector<FigureJob>& jobs) {
+  std::vector<std::string> errors(jobs.size());
+  if (jobs.empty()) return errors;
+  if (!gnuplot_available()) {   // probed once for the whole batch
     throw PlotError("gnuplot is not installed (or not on PATH): the plots need it; on Debian "
                     "install the gnuplot-nox package");
   }
@@ -317,57 +364,56 @@ void render_png(const Figure& figure, const fs::path& png) {
     }
   } cleanup{tmp};
 
-  const fs::path data_file = tmp / "data.txt";
-  const fs::path script_file = tmp / "plot.gp";
-  const fs::path out_png = tmp / "plot.png";
-  const fs::path log_file = tmp / "gnuplot.log";
+  // Every figure has its own data file, script and PNG; one batch script runs them all
+  // in a single gnuplot process (`reset` between figures, so no setting leaks over).
+  auto file = [&](std::size_t i, const char* what) { return tmp / ("figure" + std::to_string(i) + what); };
+  const fs::path batch_file = tmp / "batch.gp";
   {
-    std::ofstream data(data_file);
-    for (const Panel& panel : figure.panels) {
-      for (const Series& s : panel.series) {
-        const auto points = drawable(s, panel);
-        if (points.empty()) continue;
-        for (const auto& pt : points) {
-          if (is_gap(pt)) {
-            data << "\n";   // one blank line: a break in the line, same block
-            continue;
-          }
-          char line[80];
-          std::snprintf(line, sizeof line, "%.17g %.17g\n", pt.first, pt.second);
-          data << line;
-        }
-        data << "\n\n";   // two blank lines end a gnuplot `index` block
-      }
+    std::ofstream batch(batch_file);
+    for (std::size_t i = 0; i < jobs.size(); ++i) {
+      std::ofstream data(file(i, ".txt"));
+      write_data(jobs[i].figure, data);
+      std::ofstream script(file(i, ".gp"));
+      script << gnuplot_script(jobs[i].figure, file(i, ".txt"), file(i, ".png"));
+      if (!data || !script) throw PlotError("cannot write gnuplot input in " + tmp.string());
+      batch << "reset\nload " << gp_string(file(i, ".gp").string()) << "\n";
     }
-    std::ofstream script(script_file);
-    script << gnuplot_script(figure, data_file, out_png);
-    if (!data || !script) throw PlotError("cannot write gnuplot input in " + tmp.string());
+    if (!batch) throw PlotError("cannot write gnuplot input in " + tmp.string());
   }
+  const fs::path batch_log = tmp / "batch.log";
+  const bool batch_ok = run_gnuplot(batch_file, batch_log);
 
-  const std::string command = "gnuplot " + shell_quoted(script_file.string()) + " >" +
-                              shell_quoted(log_file.string()) + " 2>&1";
-  const int rc = std::system(command.c_str());
-  auto gnuplot_log = [&] {
-    std::ifstream in(log_file);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  };
-  if (rc == -1 || !WIFEXITED(rc) || WEXITSTATUS(rc) != 0) {
-    cleanup.keep = true;
-    throw PlotError("gnuplot failed drawing " + png.string() + " (script and data kept in " + tmp.string() +
-                    "):\n" + gnuplot_log());
+  for (std::size_t i = 0; i < jobs.size(); ++i) {
+    const fs::path out_png = file(i, ".png");
+    std::error_code ec;
+    bool drawn = batch_ok && fs::exists(out_png) && fs::file_size(out_png, ec) > 0;
+    std::string log = batch_ok ? read_text(batch_log) : std::string();
+    if (!drawn) {
+      // The batch stopped at some figure's error (gnuplot ends a script there): this
+      // figure gets its own process, so its message is its own and the others still draw.
+      const fs::path own_log = file(i, ".log");
+      const bool ok = run_gnuplot(file(i, ".gp"), own_log);
+      log = read_text(own_log);
+      if (!ok) {
+        cleanup.keep = true;
+        errors[i] = "gnuplot failed drawing " + jobs[i].png.string() + " (script and data kept in " +
+                    tmp.string() + "):\n" + log;
+        continue;
+      }
+      drawn = fs::exists(out_png) && fs::file_size(out_png, ec) > 0;
+    }
+    if (!drawn) {
+      errors[i] = "gnuplot produced no image for " + jobs[i].png.string() + ":\n" + log;
+      continue;
+    }
+    move_into_place(out_png, jobs[i].png);
   }
-  std::error_code ec;
-  if (!fs::exists(out_png) || fs::file_size(out_png, ec) == 0) {
-    throw PlotError("gnuplot produced no image for " + png.string() + ":\n" + gnuplot_log());
-  }
+  return errors;
+}
 
-  // Into place whole: copy next to the target, then rename over it.
-  if (png.has_parent_path()) fs::create_directories(png.parent_path());
-  const fs::path staged = png.string() + ".tmp";
-  fs::copy_file(out_png, staged, fs::copy_options::overwrite_existing);
-  fs::rename(staged, png);
+void render_png(const Figure& figure, const fs::path& png) {
+  const std::vector<std::string> errors = render_pngs({FigureJob{figure, png}});
+  if (!errors.front().empty()) throw PlotError(errors.front());
 }
 
 }  // namespace physval::plot

@@ -461,8 +461,12 @@ void write_sweep(const std::filesystem::path& dir, const SweepResult& result) {
   std::filesystem::create_directories(dir);
   write_file_atomically(dir / "sweep.csv", sweep_to_csv(result));
   write_file_atomically(dir / "sweep.json", sweep_to_json(result).dump(2) + "\n");
-  plot::render_png(speed_vs_error_figure(result), dir / "speed_vs_error.png");
-  plot::render_png(error_vs_dt_figure(result), dir / "error_vs_dt.png");
+  // Both plots with one gnuplot process.
+  const std::vector<std::string> errors = plot::render_pngs(
+      {{speed_vs_error_figure(result), dir / "speed_vs_error.png"}, {error_vs_dt_figure(result), dir / "error_vs_dt.png"}});
+  std::string message;
+  for (const std::string& e : errors) message += e.empty() ? "" : (message.empty() ? "" : "\n") + e;
+  if (!message.empty()) throw plot::PlotError(message);
 }
 
 }  // namespace physval

@@ -150,6 +150,37 @@ TEST(Plot, SeriesWithNothingToDrawStayInTheLegendOnly) {
   EXPECT_NE(script.find("set logscale y"), std::string::npos);
 }
 
+// Many figures, one gnuplot process: each lands at its own path with its own size and
+// settings (a log axis in the first does not leak into the next), and a figure gnuplot
+// rejects (an unknown colour name) is reported alone while the others are drawn.
+TEST(Plot, RendersABatchAndIsolatesABadFigure) {
+  const fs::path dir = fresh_dir("batch");
+  Figure good;
+  good.width = 640;
+  good.height = 400;
+  Panel p;
+  p.x = {"x", true, {}, {}, {}, 0};
+  p.y = {"y", true, {}, {}, {}, 0};
+  p.series = {line("a", 1.0)};
+  good.panels.push_back(p);
+  Figure linear = good;
+  linear.width = 500;
+  linear.panels[0].x.log = false;
+  linear.panels[0].y.log = false;
+  Figure bad = good;
+  bad.panels[0].series[0].rgb = "no-such-colour";
+  const std::vector<std::string> errors =
+      render_pngs({{good, dir / "a.png"}, {bad, dir / "bad.png"}, {linear, dir / "c.png"}});
+  ASSERT_EQ(errors.size(), 3u);
+  EXPECT_EQ(errors[0], "");
+  EXPECT_NE(errors[1], "") << "gnuplot accepted an unknown colour";
+  EXPECT_EQ(errors[2], "");
+  EXPECT_EQ(read_png(dir / "a.png").width, 640u);
+  EXPECT_EQ(read_png(dir / "c.png").width, 500u);
+  EXPECT_FALSE(fs::exists(dir / "bad.png"));
+  fs::remove_all(dir);
+}
+
 TEST(Plot, MissingGnuplotIsAClearError) {
   const char* old_path = std::getenv("PATH");
   const std::string saved = old_path != nullptr ? old_path : "";
