@@ -118,9 +118,30 @@ std::string axis_commands(char name, const Axis& axis, const Extent& data, bool 
     os << "set m" << a << "tics " << (log_step > 0.0 ? "default" : "10") << "\n";
   } else {
     // Enough digits for an axis over a narrow band (a conserved quantity's wobble).
-    os << "unset logscale " << a << "\nset format " << a << " \"%.10g\"\nset m" << a << "tics default\n";
+    // Just enough significant digits to tell neighbouring tics apart (about eight tics
+    // over the span), at most ten: a wobble of 5e-8 around 2.5 reads 2.4999999, 2.5.
+    int digits = 6;
+    if (!data.empty() && data.hi > data.lo) {
+      const double magnitude = std::max(std::abs(data.lo), std::abs(data.hi));
+      digits = std::clamp(static_cast<int>(std::ceil(std::log10(magnitude / ((data.hi - data.lo) / 8.0)))) + 1, 3, 10);
+    }
+    os << "unset logscale " << a << "\nset format " << a << " \"%." << digits << "g\"\nset m" << a
+       << "tics default\n";
   }
-  if (!axis.tics.empty()) {
+  // A log axis spanning less than a decade holds no power of ten, so gnuplot would label
+  // nothing: tics at the data's own ends (and the margins) instead.
+  std::vector<double> narrow_log_tics;
+  if (axis.log && axis.tics.empty() && !data.empty() && data.hi / data.lo < 10.0) {
+    narrow_log_tics = {data.lo / 2.0, data.lo};
+    if (data.hi / data.lo > 1.5) narrow_log_tics.push_back(data.hi);
+    narrow_log_tics.push_back(data.hi * 2.0);
+    os << "set format " << a << " \"%.3g\"\n";
+  }
+  if (!narrow_log_tics.empty()) {
+    os << "set " << a << "tics (";
+    for (std::size_t i = 0; i < narrow_log_tics.size(); ++i) os << (i ? ", " : "") << number(narrow_log_tics[i]);
+    os << ") norotate enhanced\n";
+  } else if (!axis.tics.empty()) {
     os << "set " << a << "tics (";
     for (std::size_t i = 0; i < axis.tics.size(); ++i) {
       if (i > 0) os << ", ";
@@ -219,7 +240,20 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
     os << "unset label\n";
     os << "set title " << gp_string(title) << " noenhanced font ',12'\n";
     const bool key_below = panel.key.find("below") != std::string::npos;
-    os << axis_commands('x', panel.x, ex, key_below) << axis_commands('y', panel.y, ey);
+    // A linear y axis over a band far narrower than its values (a conserved energy's
+    // wobble, 2.5 J +- 5e-8) is drawn as the offset from a round value, named in the
+    // label: tics read -4e-07, -2e-07, 0 instead of 2.4999996, 2.4999998, 2.5.
+    double y_offset = 0.0;
+    plot::Axis y_axis = panel.y;
+    if (!panel.y.log && !panel.y.min && !panel.y.max && panel.y.tics.empty() && !ey.empty() && ey.hi > ey.lo &&
+        std::max(std::abs(ey.lo), std::abs(ey.hi)) / (ey.hi - ey.lo) > 1e4) {
+      const double unit = std::pow(10.0, std::ceil(std::log10(ey.hi - ey.lo)));
+      y_offset = std::round(ey.hi / unit) * unit;
+      y_axis.label += " - " + number(y_offset);
+      ey.lo -= y_offset;
+      ey.hi -= y_offset;
+    }
+    os << axis_commands('x', panel.x, ex, key_below) << axis_commands('y', y_axis, ey);
     if (panel.key == "off") {
       os << "set key off\n";
     } else {
@@ -262,7 +296,8 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
         continue;
       }
       std::ostringstream p;
-      p << gp_string(data_file.string()) << " index " << block << " using 1:2 with " << style_of(s)
+      p << gp_string(data_file.string()) << " index " << block
+        << (y_offset != 0.0 ? " using 1:($2-(" + number(y_offset) + "))" : std::string(" using 1:2")) << " with " << style_of(s)
         << " lc rgb '"
         << (s.rgb.empty() ? palette()[static_cast<std::size_t>(colour) % palette().size()] : s.rgb) << "'"
         << " lw " << number(s.line_width) << " dt " << s.dash;

@@ -150,6 +150,10 @@ plot::Figure energy_figure(const ScenarioView& v, const std::vector<std::string>
   error.y.label = "|E(t) - E(0)| (J, log scale)";
   error.y.log = true;
   error.key = "outside right top";
+  if (v.duration > 0.0) {   // both panels over the whole run, so their time axes line up
+    total.x.min = error.x.min = 0.0;
+    total.x.max = error.x.max = v.duration;
+  }
   for (const Source& s : v.sources) {
     const auto* t = s.table.column("t");
     const auto* e = s.table.column("energy");

@@ -181,6 +181,30 @@ TEST(Plot, RendersABatchAndIsolatesABadFigure) {
   fs::remove_all(dir);
 }
 
+// Readable tics: a log axis under one decade (a constant error) gets labelled tics at
+// its data, and a linear axis over a narrow band around 2.5 is drawn as an offset.
+TEST(Plot, TicsStayReadableOnNarrowAxes) {
+  Figure fig;
+  Panel constant;
+  constant.y.log = true;
+  Series c;
+  c.x = {1.0, 2.0, 3.0};
+  c.y = {4.77e-7, 4.77e-7, 4.77e-7};
+  constant.series.push_back(c);
+  Panel band;
+  Series b;
+  b.x = {0.0, 1.0, 2.0};
+  b.y = {2.5, 2.49999995, 2.4999995};
+  b.title = "energy";
+  band.y.label = "energy (J)";
+  band.series.push_back(b);
+  fig.panels = {constant, band};
+  const std::string script = gnuplot_script(fig, "d.txt", "o.png");
+  EXPECT_NE(script.find("set ytics (2.385e-07, 4.77e-07, 9.54e-07)"), std::string::npos) << script;
+  EXPECT_NE(script.find("energy (J) - 2.5"), std::string::npos) << script;
+  EXPECT_NE(script.find("using 1:($2-(2.5))"), std::string::npos) << script;
+}
+
 TEST(Plot, MissingGnuplotIsAClearError) {
   const char* old_path = std::getenv("PATH");
   const std::string saved = old_path != nullptr ? old_path : "";
