@@ -290,6 +290,22 @@ plot::Figure trajectory_figure(const ScenarioView& v, const std::vector<std::str
     p.y.min = cy - 0.55 * ys;
     p.y.max = cy + 0.55 * ys;
   }
+  // Names that would print over one another (a gas, a stack): only the first of any
+  // that start within a label's size of each other keeps its name.
+  if (p.x.min && p.x.max && p.y.min && p.y.max) {
+    const double dx = 0.08 * (*p.x.max - *p.x.min), dy = 0.05 * (*p.y.max - *p.y.min);
+    std::vector<plot::Label> kept;
+    for (const plot::Label& l : p.labels) {
+      const bool clash = std::any_of(kept.begin(), kept.end(), [&](const plot::Label& k) {
+        return std::abs(k.x - l.x) < dx && std::abs(k.y - l.y) < dy;
+      });
+      if (!clash) kept.push_back(l);
+    }
+    if (kept.size() < p.labels.size()) {
+      p.note = std::to_string(p.labels.size() - kept.size()) + " body names left out where they would overlap";
+    }
+    p.labels = std::move(kept);
+  }
   fig.title = v.name + ": trajectories, engines overlaid on the reference";
   p.title = "each body's path; its name marks the start, a marker the end";
   if (body_total > kMaxTrajectoryBodies) {
