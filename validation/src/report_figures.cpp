@@ -500,7 +500,8 @@ plot::Figure overview_figure(const std::vector<ScenarioView>& views, const std::
   // Scenarios are rows (top to bottom in suite order), so their names read
   // horizontally; the two measures side by side share the rows.
   plot::Figure fig;
-  fig.title = "all scenarios: how far each engine strays from the reference (a missing point: not measured, or zero)";
+  fig.title = "all scenarios: how far each engine strays from the reference\n"
+              "open marker at the left edge: exactly 0; no marker: not measured";
   fig.width = 1100;
   fig.columns = 2;
   fig.height = std::max(420, 150 + 22 * static_cast<int>(views.size()));
@@ -530,6 +531,15 @@ plot::Figure overview_figure(const std::vector<ScenarioView>& views, const std::
       for (const ScenarioView& v : views) longest = std::max(longest, v.name.size());
       p.left_margin = static_cast<int>(longest) + 3;
     }
+    // Exact zeros cannot sit on a log axis: they are drawn as open markers at a fixed
+    // place left of every measured value, so "0" and "not measured" look different.
+    double smallest = INFINITY;
+    for (const ScenarioView& v : views) {
+      for (const json* run : v.runs) {
+        if (auto m = num(member(*run, "metrics"), part.metric); m && *m > 0.0) smallest = std::min(smallest, *m);
+      }
+    }
+    const double zero_at = std::isfinite(smallest) ? smallest / 30.0 : 1e-16;
     for (const std::string& engine : engines) {
       plot::Series s;
       s.title = engine;
@@ -538,16 +548,21 @@ plot::Figure overview_figure(const std::vector<ScenarioView>& views, const std::
       const Look l = look_of(engines, engine);
       s.color = l.colour;
       s.point_type = std::vector<int>{7, 5, 9, 13, 11}[static_cast<std::size_t>(l.colour) % 5];
+      plot::Series zeros = s;   // the same engine's exact zeros: the open version of its marker
+      zeros.title = engine + " = 0";
+      zeros.point_type = s.point_type - 1;
       for (std::size_t i = 0; i < views.size(); ++i) {
         for (const json* run : views[i].runs) {
           if (str(*run, "engine") != engine) continue;
           if (auto m = num(member(*run, "metrics"), part.metric)) {
-            s.x.push_back(*m);
-            s.y.push_back(row(i));
+            plot::Series& into = *m == 0.0 ? zeros : s;
+            into.x.push_back(*m == 0.0 ? zero_at : *m);
+            into.y.push_back(row(i));
           }
         }
       }
       p.series.push_back(std::move(s));
+      if (!zeros.x.empty()) p.series.push_back(std::move(zeros));
     }
     fig.panels.push_back(std::move(p));
   }

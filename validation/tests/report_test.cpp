@@ -210,5 +210,25 @@ TEST(Report, TrajectoryNamesDoNotCollide) {
   EXPECT_NE(fig.panels[0].note.find("2 body names left out"), std::string::npos) << fig.panels[0].note;
 }
 
+// The overview tells an exact zero from "not measured": a zero becomes an open marker
+// in its own series (left of every measured value), a null no point at all.
+TEST(Report, OverviewTellsZeroFromNotMeasured) {
+  const nlohmann::json zero = {{"engine", "core"}, {"metrics", {{"position_divergence", 0.0}}}};
+  const nlohmann::json some = {{"engine", "core"}, {"metrics", {{"position_divergence", 1e-3}}}};
+  const nlohmann::json none = {{"engine", "core"}, {"metrics", {{"position_divergence", nullptr}}}};
+  std::vector<report_detail::ScenarioView> views(3);
+  views[0].runs = {&zero};
+  views[1].runs = {&some};
+  views[2].runs = {&none};
+  const plot::Figure fig = report_detail::overview_figure(views, {"core"});
+  const plot::Panel& p = fig.panels.at(0);
+  ASSERT_EQ(p.series.size(), 2u);
+  EXPECT_EQ(p.series[0].x, std::vector<double>{1e-3});
+  EXPECT_EQ(p.series[1].title, "core = 0");
+  ASSERT_EQ(p.series[1].x.size(), 1u);
+  EXPECT_LT(p.series[1].x[0], 1e-3);
+  EXPECT_NE(p.series[1].point_type, p.series[0].point_type);
+}
+
 }  // namespace
 }  // namespace physval
