@@ -121,6 +121,15 @@ void print_suite_table(std::ostream& os, const SuiteResult& result) {
         }
       }
     }
+    // Containment, one line per scenario (the columns above fill the 100-character width).
+    std::string containment;
+    for (const RunRecord& r : sr.runs) {
+      const std::string pen = metric(r, "max_penetration");
+      if (pen == "-") continue;
+      containment += (containment.empty() ? "" : ", ") + r.engine + " " + pen + " m";
+      if (count(r, "escaped_bodies") != "-") containment += " (" + count(r, "escaped_bodies") + " escaped)";
+    }
+    if (!containment.empty()) note(os, "max penetration: " + containment);
     for (const PairComparison& p : sr.pairs) {
       auto m = [&](const char* k) {
         auto it = p.metrics.find(k);
