@@ -10,6 +10,7 @@
 #include "physval/adapters/registry.hpp"
 #include "physval/validation/conservation.hpp"
 #include "physval/validation/metric_names.hpp"
+#include "containment.hpp"
 
 namespace physval {
 
@@ -346,6 +347,21 @@ void compare_run(RunRecord& run, const Scene& scene, const Reference& reference,
       run.status = RunStatus::Diverged;
       run.diverged_at = runaway_at;
       run.reason = "energy ran away: it changed by " + fmt(de) + " x the scene's energy scale";
+    }
+  }
+
+  // Containment: overlap depth, and bodies that left their walls' enclosure (tunnelling):
+  // an escape makes the run diverged at the first sample a body was outside.
+  if (!s.states.empty()) {
+    const Containment c = measure_containment(scene, s);
+    run.metrics["max_penetration"] = c.max_penetration;
+    if (c.escaped_bodies) run.metrics["escaped_bodies"] = *c.escaped_bodies;
+    if (c.escaped_bodies && *c.escaped_bodies > 0 && run.status == RunStatus::Ok) {
+      run.status = RunStatus::Diverged;
+      run.diverged_at = c.first_escape_time;
+      run.reason = std::to_string(*c.escaped_bodies) + " of " + std::to_string(scene.bodies.size()) +
+                   " bodies escaped the region the walls enclose (first at t = " + fmt(c.first_escape_time.value_or(0.0)) +
+                   " s)";
     }
   }
 

@@ -102,14 +102,34 @@ void print_suite_table(std::ostream& os, const SuiteResult& result) {
     for (const RunRecord& r : sr.runs) {
       if (r.status != RunStatus::Ok) note(os, r.engine + ": " + r.reason);
       for (const std::string& l : r.limits_hit) note(os, r.engine + " limit: " + l);
+      // Enforced checks fail the run; the others (single expectations, gate limits in
+      // `run`) are reported only: known misses, bounded by the engines' tolerances,
+      // that leave the run ok. They are listed under one line that says so.
+      std::size_t known = 0;
+      for (const Check& c : r.checks) known += (!c.pass && !c.enforced) ? 1 : 0;
+      if (known > 0) {
+        note(os, r.engine + ": " + std::to_string(known) + " known miss" + (known == 1 ? "" : "es") +
+                     " (reported, not enforced; the run stays " + run_status_name(r.status) + "):");
+      }
       for (const Check& c : r.checks) {
         if (c.pass) continue;
-        // Enforced checks fail the run; the others (single expectations, gate limits in
-        // `run`) are reported only: the engine misses them.
-        note(os, r.engine + (c.enforced ? " FAILED " : " misses ") + c.what + ": " + num(c.value, "%.3g") + " > " +
-                     num(c.limit, "%.3g"));
+        const std::string off = c.value ? "off by " + num(c.value, "%.3g") : std::string("not measured");
+        if (c.enforced) {
+          note(os, r.engine + " FAILED " + c.what + ": " + off + ", allowed " + num(c.limit, "%.3g"));
+        } else {
+          note(os, "- " + c.what + ": " + off + ", allowed " + num(c.limit, "%.3g"));
+        }
       }
     }
+    // Containment, one line per scenario (the columns above fill the 100-character width).
+    std::string containment;
+    for (const RunRecord& r : sr.runs) {
+      const std::string pen = metric(r, "max_penetration");
+      if (pen == "-") continue;
+      containment += (containment.empty() ? "" : ", ") + r.engine + " " + pen + " m";
+      if (count(r, "escaped_bodies") != "-") containment += " (" + count(r, "escaped_bodies") + " escaped)";
+    }
+    if (!containment.empty()) note(os, "max penetration: " + containment);
     for (const PairComparison& p : sr.pairs) {
       auto m = [&](const char* k) {
         auto it = p.metrics.find(k);

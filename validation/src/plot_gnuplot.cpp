@@ -118,9 +118,30 @@ std::string axis_commands(char name, const Axis& axis, const Extent& data, bool 
     os << "set m" << a << "tics " << (log_step > 0.0 ? "default" : "10") << "\n";
   } else {
     // Enough digits for an axis over a narrow band (a conserved quantity's wobble).
-    os << "unset logscale " << a << "\nset format " << a << " \"%.10g\"\nset m" << a << "tics default\n";
+    // Just enough significant digits to tell neighbouring tics apart (about eight tics
+    // over the span), at most ten: a wobble of 5e-8 around 2.5 reads 2.4999999, 2.5.
+    int digits = 6;
+    if (!data.empty() && data.hi > data.lo) {
+      const double magnitude = std::max(std::abs(data.lo), std::abs(data.hi));
+      digits = std::clamp(static_cast<int>(std::ceil(std::log10(magnitude / ((data.hi - data.lo) / 8.0)))) + 1, 3, 10);
+    }
+    os << "unset logscale " << a << "\nset format " << a << " \"%." << digits << "g\"\nset m" << a
+       << "tics default\n";
   }
-  if (!axis.tics.empty()) {
+  // A log axis spanning less than a decade holds no power of ten, so gnuplot would label
+  // nothing: tics at the data's own ends (and the margins) instead.
+  std::vector<double> narrow_log_tics;
+  if (axis.log && axis.tics.empty() && !data.empty() && data.hi / data.lo < 10.0) {
+    narrow_log_tics = {data.lo / 2.0, data.lo};
+    if (data.hi / data.lo > 1.5) narrow_log_tics.push_back(data.hi);
+    narrow_log_tics.push_back(data.hi * 2.0);
+    os << "set format " << a << " \"%.3g\"\n";
+  }
+  if (!narrow_log_tics.empty()) {
+    os << "set " << a << "tics (";
+    for (std::size_t i = 0; i < narrow_log_tics.size(); ++i) os << (i ? ", " : "") << number(narrow_log_tics[i]);
+    os << ") norotate enhanced\n";
+  } else if (!axis.tics.empty()) {
     os << "set " << a << "tics (";
     for (std::size_t i = 0; i < axis.tics.size(); ++i) {
       if (i > 0) os << ", ";
@@ -219,7 +240,20 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
     os << "unset label\n";
     os << "set title " << gp_string(title) << " noenhanced font ',12'\n";
     const bool key_below = panel.key.find("below") != std::string::npos;
-    os << axis_commands('x', panel.x, ex, key_below) << axis_commands('y', panel.y, ey);
+    // A linear y axis over a band far narrower than its values (a conserved energy's
+    // wobble, 2.5 J +- 5e-8) is drawn as the offset from a round value, named in the
+    // label: tics read -4e-07, -2e-07, 0 instead of 2.4999996, 2.4999998, 2.5.
+    double y_offset = 0.0;
+    plot::Axis y_axis = panel.y;
+    if (!panel.y.log && !panel.y.min && !panel.y.max && panel.y.tics.empty() && !ey.empty() && ey.hi > ey.lo &&
+        std::max(std::abs(ey.lo), std::abs(ey.hi)) / (ey.hi - ey.lo) > 1e4) {
+      const double unit = std::pow(10.0, std::ceil(std::log10(ey.hi - ey.lo)));
+      y_offset = std::round(ey.hi / unit) * unit;
+      y_axis.label += " - " + number(y_offset);
+      ey.lo -= y_offset;
+      ey.hi -= y_offset;
+    }
+    os << axis_commands('x', panel.x, ex, key_below) << axis_commands('y', y_axis, ey);
     if (panel.key == "off") {
       os << "set key off\n";
     } else {
@@ -262,7 +296,8 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
         continue;
       }
       std::ostringstream p;
-      p << gp_string(data_file.string()) << " index " << block << " using 1:2 with " << style_of(s)
+      p << gp_string(data_file.string()) << " index " << block
+        << (y_offset != 0.0 ? " using 1:($2-(" + number(y_offset) + "))" : std::string(" using 1:2")) << " with " << style_of(s)
         << " lc rgb '"
         << (s.rgb.empty() ? palette()[static_cast<std::size_t>(colour) % palette().size()] : s.rgb) << "'"
         << " lw " << number(s.line_width) << " dt " << s.dash;
@@ -297,8 +332,55 @@ std::string gnuplot_script(const Figure& figure, const fs::path& data_file, cons
   return os.str();
 }
 
-void render_png(const Figure& figure, const fs::path& png) {
-  if (!gnuplot_available()) {
+namespace {
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void write_data(const Figure& figure, std::ostream& data) {
+  for (const Panel& panel : figure.panels) {
+    for (const Series& s : panel.series) {
+      const auto points = drawable(s, panel);
+      if (points.empty()) continue;
+      for (const auto& pt : points) {
+        if (is_gap(pt)) {
+          data << "\n";   // one blank line: a break in the line, same block
+          continue;
+        }
+        char line[80];
+        std::snprintf(line, sizeof line, "%.17g %.17g\n", pt.first, pt.second);
+        data << line;
+      }
+      data << "\n\n";   // two blank lines end a gnuplot `index` block
+    }
+  }
+}
+
+// Runs gnuplot once on `script`, its messages into `log`; whether it exited 0.
+bool run_gnuplot(const fs::path& script, const fs::path& log) {
+  const std::string command = "gnuplot " + shell_quoted(script.string()) + " >" + shell_quoted(log.string()) + " 2>&1";
+  const int rc = std::system(command.c_str());
+  return rc != -1 && WIFEXITED(rc) && WEXITSTATUS(rc) == 0;
+}
+
+// Into place whole: copy next to the target, then rename over it.
+void move_into_place(const fs::path& from, const fs::path& png) {
+  if (png.has_parent_path()) fs::create_directories(png.parent_path());
+  const fs::path staged = png.string() + ".tmp";
+  fs::copy_file(from, staged, fs::copy_options::overwrite_existing);
+  fs::rename(staged, png);
+}
+
+}  // namespace
+
+std::vector<std::string> render_pngs(const std::vector<FigureJob>& jobs) {
+  std::vector<std::string> errors(jobs.size());
+  if (jobs.empty()) return errors;
+  if (!gnuplot_available()) {   // probed once for the whole batch
     throw PlotError("gnuplot is not installed (or not on PATH): the plots need it; on Debian "
                     "install the gnuplot-nox package");
   }
@@ -317,57 +399,56 @@ void render_png(const Figure& figure, const fs::path& png) {
     }
   } cleanup{tmp};
 
-  const fs::path data_file = tmp / "data.txt";
-  const fs::path script_file = tmp / "plot.gp";
-  const fs::path out_png = tmp / "plot.png";
-  const fs::path log_file = tmp / "gnuplot.log";
+  // Every figure has its own data file, script and PNG; one batch script runs them all
+  // in a single gnuplot process (`reset` between figures, so no setting leaks over).
+  auto file = [&](std::size_t i, const char* what) { return tmp / ("figure" + std::to_string(i) + what); };
+  const fs::path batch_file = tmp / "batch.gp";
   {
-    std::ofstream data(data_file);
-    for (const Panel& panel : figure.panels) {
-      for (const Series& s : panel.series) {
-        const auto points = drawable(s, panel);
-        if (points.empty()) continue;
-        for (const auto& pt : points) {
-          if (is_gap(pt)) {
-            data << "\n";   // one blank line: a break in the line, same block
-            continue;
-          }
-          char line[80];
-          std::snprintf(line, sizeof line, "%.17g %.17g\n", pt.first, pt.second);
-          data << line;
-        }
-        data << "\n\n";   // two blank lines end a gnuplot `index` block
-      }
+    std::ofstream batch(batch_file);
+    for (std::size_t i = 0; i < jobs.size(); ++i) {
+      std::ofstream data(file(i, ".txt"));
+      write_data(jobs[i].figure, data);
+      std::ofstream script(file(i, ".gp"));
+      script << gnuplot_script(jobs[i].figure, file(i, ".txt"), file(i, ".png"));
+      if (!data || !script) throw PlotError("cannot write gnuplot input in " + tmp.string());
+      batch << "reset\nload " << gp_string(file(i, ".gp").string()) << "\n";
     }
-    std::ofstream script(script_file);
-    script << gnuplot_script(figure, data_file, out_png);
-    if (!data || !script) throw PlotError("cannot write gnuplot input in " + tmp.string());
+    if (!batch) throw PlotError("cannot write gnuplot input in " + tmp.string());
   }
+  const fs::path batch_log = tmp / "batch.log";
+  const bool batch_ok = run_gnuplot(batch_file, batch_log);
 
-  const std::string command = "gnuplot " + shell_quoted(script_file.string()) + " >" +
-                              shell_quoted(log_file.string()) + " 2>&1";
-  const int rc = std::system(command.c_str());
-  auto gnuplot_log = [&] {
-    std::ifstream in(log_file);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  };
-  if (rc == -1 || !WIFEXITED(rc) || WEXITSTATUS(rc) != 0) {
-    cleanup.keep = true;
-    throw PlotError("gnuplot failed drawing " + png.string() + " (script and data kept in " + tmp.string() +
-                    "):\n" + gnuplot_log());
+  for (std::size_t i = 0; i < jobs.size(); ++i) {
+    const fs::path out_png = file(i, ".png");
+    std::error_code ec;
+    bool drawn = batch_ok && fs::exists(out_png) && fs::file_size(out_png, ec) > 0;
+    std::string log = batch_ok ? read_text(batch_log) : std::string();
+    if (!drawn) {
+      // The batch stopped at some figure's error (gnuplot ends a script there): this
+      // figure gets its own process, so its message is its own and the others still draw.
+      const fs::path own_log = file(i, ".log");
+      const bool ok = run_gnuplot(file(i, ".gp"), own_log);
+      log = read_text(own_log);
+      if (!ok) {
+        cleanup.keep = true;
+        errors[i] = "gnuplot failed drawing " + jobs[i].png.string() + " (script and data kept in " +
+                    tmp.string() + "):\n" + log;
+        continue;
+      }
+      drawn = fs::exists(out_png) && fs::file_size(out_png, ec) > 0;
+    }
+    if (!drawn) {
+      errors[i] = "gnuplot produced no image for " + jobs[i].png.string() + ":\n" + log;
+      continue;
+    }
+    move_into_place(out_png, jobs[i].png);
   }
-  std::error_code ec;
-  if (!fs::exists(out_png) || fs::file_size(out_png, ec) == 0) {
-    throw PlotError("gnuplot produced no image for " + png.string() + ":\n" + gnuplot_log());
-  }
+  return errors;
+}
 
-  // Into place whole: copy next to the target, then rename over it.
-  if (png.has_parent_path()) fs::create_directories(png.parent_path());
-  const fs::path staged = png.string() + ".tmp";
-  fs::copy_file(out_png, staged, fs::copy_options::overwrite_existing);
-  fs::rename(staged, png);
+void render_png(const Figure& figure, const fs::path& png) {
+  const std::vector<std::string> errors = render_pngs({FigureJob{figure, png}});
+  if (!errors.front().empty()) throw PlotError(errors.front());
 }
 
 }  // namespace physval::plot

@@ -199,6 +199,26 @@ std::string figure_html(const Drawn& d) {
          html(d.caption) + "</figcaption></figure>\n";
 }
 
+// A mark in the page where figure `i` goes once it is drawn (a control character, never
+// in escaped HTML).
+std::string figure_placeholder(std::size_t i) { return "\x01figure " + std::to_string(i) + "\x01"; }
+
+std::string fill_placeholders(const std::string& page, const std::vector<Drawn>& drawn) {
+  std::string out;
+  out.reserve(page.size() + drawn.size() * 300);
+  std::size_t pos = 0;
+  for (std::size_t i = 0; i < drawn.size(); ++i) {
+    const std::string mark = figure_placeholder(i);
+    const std::size_t at = page.find(mark, pos);
+    if (at == std::string::npos) continue;
+    out.append(page, pos, at - pos);
+    out += figure_html(drawn[i]);
+    pos = at + mark.size();
+  }
+  out.append(page, pos, std::string::npos);
+  return out;
+}
+
 }  // namespace
 
 std::string report_file_name(const std::string& name) {
@@ -277,16 +297,14 @@ void write_report(const fs::path& dir, const Progress& progress) {
 
   const fs::path plots = dir / "plots";
   std::vector<std::string> failures;
-  auto draw = [&](const plot::Figure& fig, const std::string& name, const std::string& alt,
-                  const std::string& caption) {
-    Drawn d{"plots/" + name + ".png", caption, alt, ""};
-    try {
-      plot::render_png(fig, plots / (name + ".png"));
-    } catch (const std::exception& e) {
-      d.error = e.what();
-      failures.push_back(name + ".png: " + d.error);
-    }
-    return d;
+  // Figures are queued while the page is written (a placeholder marks each one's place)
+  // and drawn together by one gnuplot process at the end.
+  std::vector<plot::FigureJob> jobs;
+  std::vector<Drawn> drawn;
+  auto draw = [&](plot::Figure fig, const std::string& name, const std::string& alt, const std::string& caption) {
+    jobs.push_back({std::move(fig), plots / (name + ".png")});
+    drawn.push_back(Drawn{"plots/" + name + ".png", caption, alt, ""});
+    return figure_placeholder(drawn.size() - 1);
   };
 
   std::ostringstream page;
@@ -360,8 +378,8 @@ void write_report(const fs::path& dir, const Progress& progress) {
     page << "<p class=note>No run has a measured divergence from a reference (none was available or converged), "
             "so there is no overview plot.</p>\n";
   } else {
-    say("report: overview plot");
-    page << figure_html(draw(overview_figure(views, ran), "overview", "divergence of every scenario and engine",
+    say("report: laying out the overview");
+    page << (draw(overview_figure(views, ran), "overview", "divergence of every scenario and engine",
                              "Each engine's largest position divergence and its energy divergence from the scenario's "
                              "reference, per scenario. Log scale: one grid line is a factor of ten."));
   }
@@ -369,7 +387,7 @@ void write_report(const fs::path& dir, const Progress& progress) {
   std::size_t index = 0;
   for (const ScenarioView& v : views) {
     ++index;
-    say("report: plots for " + v.name + " (" + std::to_string(index) + "/" + std::to_string(views.size()) + ")");
+    say("report: laying out " + v.name + " (" + std::to_string(index) + "/" + std::to_string(views.size()) + ")");
     const std::string base = report_file_name(v.name);
     page << "<h2 id=\"" << html(base) << "\">" << html(v.name) << "</h2>\n";
     if (v.reference != nullptr) {
@@ -396,18 +414,18 @@ void write_report(const fs::path& dir, const Progress& progress) {
       page << "<p class=note>No time series in series/" << html(base) << "/: nothing to plot.</p>\n";
       continue;
     }
-    page << figure_html(draw(energy_figure(v, engines), base + "_energy", v.name + " energy over time",
+    page << (draw(energy_figure(v, engines), base + "_energy", v.name + " energy over time",
                              "Top: total energy of each engine's run and of the reference. Bottom: how far each run's "
                              "energy has moved from its starting value, log scale (a straight rising line is a steady "
                              "drift; gaps are exact zeros)."));
-    page << figure_html(draw(momentum_figure(v, engines), base + "_momentum", v.name + " momentum over time",
+    page << (draw(momentum_figure(v, engines), base + "_momentum", v.name + " momentum over time",
                              "Linear momentum (x and y) and angular momentum about the origin, per engine. Walls, "
                              "uniform gravity and drag change momentum; compare the engines with the reference."));
-    page << figure_html(draw(trajectory_figure(v, engines), base + "_trajectories", v.name + " trajectories",
+    page << (draw(trajectory_figure(v, engines), base + "_trajectories", v.name + " trajectories",
                              "The path of each body in each engine, drawn over the reference's (thick grey). Equal "
                              "scales on both axes."));
     if (auto contacts = contact_figure(v, engines)) {
-      page << figure_html(draw(*contacts, base + "_contacts", v.name + " contact timeline",
+      page << (draw(*contacts, base + "_contacts", v.name + " contact timeline",
                                "One row per engine: where it reported a contact beginning, coloured by the pair in "
                                "contact. Grey vertical lines: the reference's contact times."));
     } else {
@@ -416,7 +434,19 @@ void write_report(const fs::path& dir, const Progress& progress) {
   }
   page << "<p class=ctx>Written by physval report from " << html(results_file.filename().string())
        << ". Plots drawn with gnuplot.</p>\n</body></html>\n";
-  write_file_atomically(dir / "report.html", page.str());
+
+  say("report: drawing " + std::to_string(jobs.size()) + " plots with one gnuplot process");
+  std::vector<std::string> errors;
+  try {
+    errors = plot::render_pngs(jobs);
+  } catch (const std::exception& e) {   // gnuplot missing: every plot says why
+    errors.assign(jobs.size(), e.what());
+  }
+  for (std::size_t i = 0; i < drawn.size(); ++i) {
+    drawn[i].error = errors[i];
+    if (!errors[i].empty()) failures.push_back(jobs[i].png.filename().string() + ": " + errors[i]);
+  }
+  write_file_atomically(dir / "report.html", fill_placeholders(page.str(), drawn));
 
   if (!failures.empty()) {
     std::string message = "report written to " + (dir / "report.html").string() + ", but " +

@@ -150,6 +150,10 @@ plot::Figure energy_figure(const ScenarioView& v, const std::vector<std::string>
   error.y.label = "|E(t) - E(0)| (J, log scale)";
   error.y.log = true;
   error.key = "outside right top";
+  if (v.duration > 0.0) {   // both panels over the whole run, so their time axes line up
+    total.x.min = error.x.min = 0.0;
+    total.x.max = error.x.max = v.duration;
+  }
   for (const Source& s : v.sources) {
     const auto* t = s.table.column("t");
     const auto* e = s.table.column("energy");
@@ -285,6 +289,22 @@ plot::Figure trajectory_figure(const ScenarioView& v, const std::vector<std::str
     p.x.max = cx + 0.55 * xs;
     p.y.min = cy - 0.55 * ys;
     p.y.max = cy + 0.55 * ys;
+  }
+  // Names that would print over one another (a gas, a stack): only the first of any
+  // that start within a label's size of each other keeps its name.
+  if (p.x.min && p.x.max && p.y.min && p.y.max) {
+    const double dx = 0.08 * (*p.x.max - *p.x.min), dy = 0.05 * (*p.y.max - *p.y.min);
+    std::vector<plot::Label> kept;
+    for (const plot::Label& l : p.labels) {
+      const bool clash = std::any_of(kept.begin(), kept.end(), [&](const plot::Label& k) {
+        return std::abs(k.x - l.x) < dx && std::abs(k.y - l.y) < dy;
+      });
+      if (!clash) kept.push_back(l);
+    }
+    if (kept.size() < p.labels.size()) {
+      p.note = std::to_string(p.labels.size() - kept.size()) + " body names left out where they would overlap";
+    }
+    p.labels = std::move(kept);
   }
   fig.title = v.name + ": trajectories, engines overlaid on the reference";
   p.title = "each body's path; its name marks the start, a marker the end";
@@ -480,7 +500,8 @@ plot::Figure overview_figure(const std::vector<ScenarioView>& views, const std::
   // Scenarios are rows (top to bottom in suite order), so their names read
   // horizontally; the two measures side by side share the rows.
   plot::Figure fig;
-  fig.title = "all scenarios: how far each engine strays from the reference (a missing point: not measured, or zero)";
+  fig.title = "all scenarios: how far each engine strays from the reference\n"
+              "open marker at the left edge: exactly 0; no marker: not measured";
   fig.width = 1100;
   fig.columns = 2;
   fig.height = std::max(420, 150 + 22 * static_cast<int>(views.size()));
@@ -510,6 +531,15 @@ plot::Figure overview_figure(const std::vector<ScenarioView>& views, const std::
       for (const ScenarioView& v : views) longest = std::max(longest, v.name.size());
       p.left_margin = static_cast<int>(longest) + 3;
     }
+    // Exact zeros cannot sit on a log axis: they are drawn as open markers at a fixed
+    // place left of every measured value, so "0" and "not measured" look different.
+    double smallest = INFINITY;
+    for (const ScenarioView& v : views) {
+      for (const json* run : v.runs) {
+        if (auto m = num(member(*run, "metrics"), part.metric); m && *m > 0.0) smallest = std::min(smallest, *m);
+      }
+    }
+    const double zero_at = std::isfinite(smallest) ? smallest / 30.0 : 1e-16;
     for (const std::string& engine : engines) {
       plot::Series s;
       s.title = engine;
@@ -518,16 +548,21 @@ plot::Figure overview_figure(const std::vector<ScenarioView>& views, const std::
       const Look l = look_of(engines, engine);
       s.color = l.colour;
       s.point_type = std::vector<int>{7, 5, 9, 13, 11}[static_cast<std::size_t>(l.colour) % 5];
+      plot::Series zeros = s;   // the same engine's exact zeros: the open version of its marker
+      zeros.title = engine + " = 0";
+      zeros.point_type = s.point_type - 1;
       for (std::size_t i = 0; i < views.size(); ++i) {
         for (const json* run : views[i].runs) {
           if (str(*run, "engine") != engine) continue;
           if (auto m = num(member(*run, "metrics"), part.metric)) {
-            s.x.push_back(*m);
-            s.y.push_back(row(i));
+            plot::Series& into = *m == 0.0 ? zeros : s;
+            into.x.push_back(*m == 0.0 ? zero_at : *m);
+            into.y.push_back(row(i));
           }
         }
       }
       p.series.push_back(std::move(s));
+      if (!zeros.x.empty()) p.series.push_back(std::move(zeros));
     }
     fig.panels.push_back(std::move(p));
   }

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <iomanip>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "physval/validation/plot.hpp"
@@ -142,6 +143,27 @@ plot::Figure speed_vs_error_figure(const SweepResult& r) {
   panel.y.log = true;
   panel.key = legend_below(groups_of(r).size() + 1);
   const auto groups = groups_of(r);
+  // The step sizes are named along the line whose points spread the most (in decades
+  // of error and time), where their labels do not pile up.
+  std::size_t labelled_group = 0;
+  double widest = -1.0;
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    double xlo = INFINITY, xhi = 0.0, ylo = INFINITY, yhi = 0.0;
+    for (std::size_t i : groups[g].second) {
+      const SweepPoint& p = r.points[i];
+      if (!usable(p) || !p.position_error || !(*p.position_error > 0.0) || !(p.wall_per_sim_median > 0.0)) continue;
+      xlo = std::min(xlo, p.wall_per_sim_median);
+      xhi = std::max(xhi, p.wall_per_sim_median);
+      ylo = std::min(ylo, *p.position_error);
+      yhi = std::max(yhi, *p.position_error);
+    }
+    const double spread = xhi > 0.0 ? std::log10(xhi / xlo) + std::log10(yhi / ylo) : -1.0;
+    if (spread > widest) {
+      widest = spread;
+      labelled_group = g;
+    }
+  }
+  std::set<double> labelled_dts;
   for (std::size_t g = 0; g < groups.size(); ++g) {
     plot::Series s;
     const SweepPoint& first = r.points[groups[g].second.front()];
@@ -153,6 +175,11 @@ plot::Figure speed_vs_error_figure(const SweepResult& r) {
       if (!usable(p) || !p.position_error) continue;
       s.x.push_back(p.wall_per_sim_median);
       s.y.push_back(*p.position_error);
+      if (g == labelled_group && labelled_dts.insert(p.dt).second) {
+        char text[48];
+        std::snprintf(text, sizeof text, "dt %.3g", p.dt);
+        panel.labels.push_back({p.wall_per_sim_median, *p.position_error, text});
+      }
     }
     panel.series.push_back(std::move(s));
   }
@@ -461,8 +488,12 @@ void write_sweep(const std::filesystem::path& dir, const SweepResult& result) {
   std::filesystem::create_directories(dir);
   write_file_atomically(dir / "sweep.csv", sweep_to_csv(result));
   write_file_atomically(dir / "sweep.json", sweep_to_json(result).dump(2) + "\n");
-  plot::render_png(speed_vs_error_figure(result), dir / "speed_vs_error.png");
-  plot::render_png(error_vs_dt_figure(result), dir / "error_vs_dt.png");
+  // Both plots with one gnuplot process.
+  const std::vector<std::string> errors = plot::render_pngs(
+      {{speed_vs_error_figure(result), dir / "speed_vs_error.png"}, {error_vs_dt_figure(result), dir / "error_vs_dt.png"}});
+  std::string message;
+  for (const std::string& e : errors) message += e.empty() ? "" : (message.empty() ? "" : "\n") + e;
+  if (!message.empty()) throw plot::PlotError(message);
 }
 
 }  // namespace physval

@@ -150,6 +150,61 @@ TEST(Plot, SeriesWithNothingToDrawStayInTheLegendOnly) {
   EXPECT_NE(script.find("set logscale y"), std::string::npos);
 }
 
+// Many figures, one gnuplot process: each lands at its own path with its own size and
+// settings (a log axis in the first does not leak into the next), and a figure gnuplot
+// rejects (an unknown colour name) is reported alone while the others are drawn.
+TEST(Plot, RendersABatchAndIsolatesABadFigure) {
+  const fs::path dir = fresh_dir("batch");
+  Figure good;
+  good.width = 640;
+  good.height = 400;
+  Panel p;
+  p.x = {"x", true, {}, {}, {}, 0};
+  p.y = {"y", true, {}, {}, {}, 0};
+  p.series = {line("a", 1.0)};
+  good.panels.push_back(p);
+  Figure linear = good;
+  linear.width = 500;
+  linear.panels[0].x.log = false;
+  linear.panels[0].y.log = false;
+  Figure bad = good;
+  bad.panels[0].series[0].rgb = "no-such-colour";
+  const std::vector<std::string> errors =
+      render_pngs({{good, dir / "a.png"}, {bad, dir / "bad.png"}, {linear, dir / "c.png"}});
+  ASSERT_EQ(errors.size(), 3u);
+  EXPECT_EQ(errors[0], "");
+  EXPECT_NE(errors[1], "") << "gnuplot accepted an unknown colour";
+  EXPECT_EQ(errors[2], "");
+  EXPECT_EQ(read_png(dir / "a.png").width, 640u);
+  EXPECT_EQ(read_png(dir / "c.png").width, 500u);
+  EXPECT_FALSE(fs::exists(dir / "bad.png"));
+  fs::remove_all(dir);
+}
+
+// Readable tics: a log axis under one decade (a constant error) gets labelled tics at
+// its data, and a linear axis over a narrow band around 2.5 is drawn as an offset.
+TEST(Plot, TicsStayReadableOnNarrowAxes) {
+  Figure fig;
+  Panel constant;
+  constant.y.log = true;
+  Series c;
+  c.x = {1.0, 2.0, 3.0};
+  c.y = {4.77e-7, 4.77e-7, 4.77e-7};
+  constant.series.push_back(c);
+  Panel band;
+  Series b;
+  b.x = {0.0, 1.0, 2.0};
+  b.y = {2.5, 2.49999995, 2.4999995};
+  b.title = "energy";
+  band.y.label = "energy (J)";
+  band.series.push_back(b);
+  fig.panels = {constant, band};
+  const std::string script = gnuplot_script(fig, "d.txt", "o.png");
+  EXPECT_NE(script.find("set ytics (2.385e-07, 4.77e-07, 9.54e-07)"), std::string::npos) << script;
+  EXPECT_NE(script.find("energy (J) - 2.5"), std::string::npos) << script;
+  EXPECT_NE(script.find("using 1:($2-(2.5))"), std::string::npos) << script;
+}
+
 TEST(Plot, MissingGnuplotIsAClearError) {
   const char* old_path = std::getenv("PATH");
   const std::string saved = old_path != nullptr ? old_path : "";

@@ -16,6 +16,7 @@
 #include "physval/validation/plot.hpp"
 #include "physval/validation/report.hpp"
 #include "physval/validation/results_json.hpp"
+#include "../src/report_figures.hpp"
 
 namespace physval {
 namespace {
@@ -187,6 +188,46 @@ TEST(Report, MissingResultsIsAnError) {
 TEST(Report, FileNamesMatchTheSeriesFolder) {
   EXPECT_EQ(report_file_name("head_on-elastic_2"), "head_on-elastic_2");
   EXPECT_EQ(report_file_name("a b/c"), "a_b_c");
+}
+
+// Body names starting on top of one another (a gas) are not printed over each other:
+// of three bodies starting within a few centimetres only one is named, the one far
+// away keeps its name, and the panel says how many names it left out.
+TEST(Report, TrajectoryNamesDoNotCollide) {
+  report_detail::ScenarioView v;
+  v.name = "crowd";
+  report_detail::Source s;
+  s.label = "core";
+  s.engine = "core";
+  s.table.names = {"t", "x_a", "y_a", "x_b", "y_b", "x_c", "y_c", "x_far", "y_far"};
+  s.table.columns = {{0, 1}, {0, 0}, {0, 1}, {0.01, 0}, {0, 1}, {0.02, 0}, {0.01, 1}, {10, 10}, {0, 1}};
+  v.sources.push_back(s);
+  const plot::Figure fig = report_detail::trajectory_figure(v, {"core"});
+  ASSERT_EQ(fig.panels.size(), 1u);
+  std::set<std::string> named;
+  for (const plot::Label& l : fig.panels[0].labels) named.insert(l.text);
+  EXPECT_EQ(named, (std::set<std::string>{"a", "far"}));
+  EXPECT_NE(fig.panels[0].note.find("2 body names left out"), std::string::npos) << fig.panels[0].note;
+}
+
+// The overview tells an exact zero from "not measured": a zero becomes an open marker
+// in its own series (left of every measured value), a null no point at all.
+TEST(Report, OverviewTellsZeroFromNotMeasured) {
+  const nlohmann::json zero = {{"engine", "core"}, {"metrics", {{"position_divergence", 0.0}}}};
+  const nlohmann::json some = {{"engine", "core"}, {"metrics", {{"position_divergence", 1e-3}}}};
+  const nlohmann::json none = {{"engine", "core"}, {"metrics", {{"position_divergence", nullptr}}}};
+  std::vector<report_detail::ScenarioView> views(3);
+  views[0].runs = {&zero};
+  views[1].runs = {&some};
+  views[2].runs = {&none};
+  const plot::Figure fig = report_detail::overview_figure(views, {"core"});
+  const plot::Panel& p = fig.panels.at(0);
+  ASSERT_EQ(p.series.size(), 2u);
+  EXPECT_EQ(p.series[0].x, std::vector<double>{1e-3});
+  EXPECT_EQ(p.series[1].title, "core = 0");
+  ASSERT_EQ(p.series[1].x.size(), 1u);
+  EXPECT_LT(p.series[1].x[0], 1e-3);
+  EXPECT_NE(p.series[1].point_type, p.series[0].point_type);
 }
 
 }  // namespace

@@ -261,3 +261,59 @@ TEST(VerdictCompare, DestructionAtASampleTimeIsNotAnEnergyDivergence) {
 }
 
 }  // namespace
+
+#include <nlohmann/json.hpp>
+
+namespace {
+
+// Item 5: a run that let bodies out of a closed box was `ok`. Now escaped_bodies counts
+// them and the run is diverged at the first escape; max_penetration is measured.
+TEST_F(Verdict, EscapeFromAClosedBoxIsDiverged) {
+  const fs::path f = write("box.toml", R"(name = "box"
+duration = 1.0
+dt = 0.05
+[[bodies]]
+name = "fast"
+radius = 0.05
+position = [0.0, 0.0]
+velocity = [40.0, 0.0]
+[[walls]]
+from = [-1.0, -1.0]
+to = [1.0, -1.0]
+[[walls]]
+from = [1.0, -1.0]
+to = [1.0, 1.0]
+[[walls]]
+from = [1.0, 1.0]
+to = [-1.0, 1.0]
+[[walls]]
+from = [-1.0, 1.0]
+to = [-1.0, -1.0]
+[bullet]
+wall_half_thickness = 0.0
+[gate]
+escaped_bodies = 0
+)");
+  const fs::path o = dir_ / "out";
+  const Result r = physval("run --engines core,bullet --quiet --out " + o.string() + " " + f.string());
+  const nlohmann::json results = nlohmann::json::parse(read_text(o / "results.json"));
+  bool saw_core = false, saw_bullet = false;
+  for (const nlohmann::json& run : results["runs"]) {
+    const nlohmann::json& m = run["metrics"];
+    ASSERT_TRUE(m.contains("escaped_bodies") && m.contains("max_penetration")) << run.dump();
+    if (run["engine"] == "core") {
+      saw_core = true;
+      EXPECT_EQ(m["escaped_bodies"].get<double>(), 0.0) << run.dump();
+      EXPECT_EQ(run["status"], "ok") << run.dump();
+    } else {
+      saw_bullet = true;
+      // 40 m/s at dt 0.05 is a 2 m step: discrete Bullet steps over the wall.
+      EXPECT_EQ(m["escaped_bodies"].get<double>(), 1.0) << run.dump();
+      EXPECT_EQ(run["status"], "diverged") << run.dump();
+    }
+  }
+  EXPECT_TRUE(saw_core && saw_bullet) << r.output;
+  EXPECT_EQ(r.status, 1) << r.output;
+}
+
+}  // namespace

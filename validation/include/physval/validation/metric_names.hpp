@@ -7,7 +7,7 @@
 
 namespace physval {
 
-inline constexpr std::array<std::string_view, 16> kMetricNames = {
+inline constexpr std::array<std::string_view, 18> kMetricNames = {
     "energy_drift",
     "linear_momentum_drift",
     "angular_momentum_drift",
@@ -24,6 +24,8 @@ inline constexpr std::array<std::string_view, 16> kMetricNames = {
     "extra_contacts",
     "wall_seconds",
     "expectation_failures",
+    "max_penetration",
+    "escaped_bodies",
 };
 
 inline bool is_metric_name(std::string_view name) {

@@ -87,4 +87,15 @@ std::string gnuplot_script(const Figure& figure, const std::filesystem::path& da
 // message on failure, or when gnuplot is missing.
 void render_png(const Figure& figure, const std::filesystem::path& png);
 
+struct FigureJob {
+  Figure figure;
+  std::filesystem::path png;
+};
+
+// Renders many figures with one gnuplot process (and one probe for gnuplot), the way
+// a report draws its dozens of plots. Returns one message per job, "" where the PNG
+// was drawn; a figure whose script fails is retried alone, so one bad figure does not
+// lose the others. Throws PlotError only when gnuplot is missing.
+std::vector<std::string> render_pngs(const std::vector<FigureJob>& jobs);
+
 }  // namespace physval::plot
