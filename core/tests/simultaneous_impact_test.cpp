@@ -139,6 +139,15 @@ TEST(CoreSimultaneousImpact, SequentialLawDependsOnNumberingAndIsKeptAsAnOption)
   EXPECT_EQ(id->second, "simultaneous");
 }
 
+TEST(CoreSimultaneousImpact, ImpactLawIsDeclaredWithItsValues) {
+  const EngineInfo info = core_engine_factory().info;
+  const auto it = std::find_if(info.options.begin(), info.options.end(),
+                               [](const OptionSpec& o) { return o.key == "impact_law"; });
+  ASSERT_NE(it, info.options.end());
+  EXPECT_EQ(std::get<std::string>(it->default_value), "simultaneous");
+  EXPECT_EQ(it->choices, (std::vector<std::string>{"simultaneous", "sequential"}));
+}
+
 TEST(CoreSimultaneousImpact, UnknownImpactLawIsRejected) {
   EXPECT_THROW(Sim(triple_scene(0.6, 1.0, {0, 1, 2}, false, 0.3), {{"impact_law", std::string("both")}}),
                std::exception);
