@@ -19,6 +19,7 @@
 #include "physval/validation/results_json.hpp"
 #include "physval/validation/scenario_loader.hpp"
 #include "physval/validation/suite.hpp"
+#include "physval/validation/scheduler.hpp"
 #include "physval/validation/sweep.hpp"
 
 namespace {
@@ -61,6 +62,7 @@ struct CommonOptions {
   bool no_isolate = false;
   double timeout = 0.0;
   bool quiet = false;
+  int jobs = 0;   // 0: every core
 };
 
 void add_common(CLI::App* cmd, CommonOptions& o) {
@@ -72,6 +74,7 @@ void add_common(CLI::App* cmd, CommonOptions& o) {
   cmd->add_flag("--no-isolate", o.no_isolate, "run engines in this process (debugging; a crash then ends physval)");
   cmd->add_option("--timeout", o.timeout, "seconds a single engine run may take before it is stopped (0: no limit)");
   cmd->add_flag("--quiet", o.quiet, "print only the summary line");
+  cmd->add_option("-j,--jobs", o.jobs, "references and engine runs at once (default 0: every core); results do not depend on it");
 }
 
 int bad_input(const std::string& message) {
@@ -115,6 +118,7 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
     if (find_engine(e) == nullptr) return bad_input("--engines: no engine named \"" + e + "\" (see `physval engines`)");
   }
   if (o.timeout < 0.0) return bad_input("--timeout must be >= 0");
+  if (o.jobs < 0) return bad_input("--jobs must be >= 0 (0: every core)");
   options.isolate = !o.no_isolate;
   options.timeout_seconds = o.timeout;
   nlohmann::json baseline;
@@ -133,8 +137,10 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
   if (!scenes) return kExitBadInput;
 
   const Progress progress = terminal_progress(o.quiet);
+  const std::size_t jobs = o.jobs > 0 ? static_cast<std::size_t>(o.jobs) : default_jobs();
   SuiteResult result = run_suite(*scenes, o.engines, options, gate,
-                                 progress ? Progress([&](const std::string& l) { progress("running " + l); }) : Progress{});
+                                 progress ? Progress([&](const std::string& l) { progress("running " + l); }) : Progress{},
+                                 jobs);
   end_progress(progress);
   if (!baseline_path.empty()) {
     const int matched = apply_baseline(result, baseline, baseline_factor);
