@@ -4,6 +4,7 @@
 #include <mutex>
 #include <sstream>
 
+#include "physval/validation/reference_cache.hpp"
 #include "physval/validation/scheduler.hpp"
 
 namespace physval {
@@ -72,7 +73,7 @@ SuiteResult run_suite(const std::vector<Scene>& scenes, const std::vector<std::s
     ScenarioResult& sr = result.scenarios[t.scenario];
     say(t);
     if (t.engine == nullptr) {
-      sr.reference = make_reference(sr.scene, options);
+      sr.reference = cached_reference(sr.scene, options).reference;
     } else {
       sr.runs[t.slot] = run_engine_isolated(sr.scene, *t.engine, options);
     }

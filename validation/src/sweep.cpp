@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "physval/validation/comparator.hpp"
+#include "physval/validation/reference_cache.hpp"
 #include "physval/validation/runner.hpp"
 
 namespace physval {
@@ -190,11 +191,12 @@ SweepResult run_sweep(const Scene& scene, const SweepOptions& options, const Pro
   // One reference for every point, at least as fine as the finest step swept.
   RunOptions ref_options;
   ref_options.dt = std::min(scene.dt, dts.back());
+  ref_options.reference_cache = options.reference_cache;
   const Scene ref_scene = effective_scene(sampled, ref_options);
   say("sweep " + scene.name + ": building the reference (dt " + dt_label(ref_scene.dt) + ")");
   Reference reference;
   try {
-    reference = make_reference(ref_scene, ref_options);
+    reference = cached_reference(ref_scene, ref_options).reference;
   } catch (const std::exception& e) {
     reference = Reference{};
     reference.reason = e.what();
