@@ -295,6 +295,8 @@ int main(int argc, char** argv) {
   bool sweep_no_cache = false;
   sweep->add_option("--cache", sweep_cache, "reference cache folder (default as for run)");
   sweep->add_flag("--no-cache", sweep_no_cache, "compute the reference, read and write no cache");
+  int sweep_jobs = 0;
+  sweep->add_option("-j,--jobs", sweep_jobs, "error runs at once (default 0: every core); timing runs are always alone");
   sweep->add_option("--timeout", sweep_timeout, "seconds a single measured run may take before it is stopped (0: no limit)");
 
   std::string report_dir;
@@ -361,6 +363,8 @@ int main(int argc, char** argv) {
       if (sweep_repetitions < 1) return bad_input("--repetitions must be >= 1");
       if (sweep_timeout < 0.0) return bad_input("--timeout must be >= 0");
       so.timeout_seconds = sweep_timeout;
+      if (sweep_jobs < 0) return bad_input("--jobs must be >= 0 (0: every core)");
+      so.jobs = sweep_jobs > 0 ? static_cast<std::size_t>(sweep_jobs) : default_jobs();
       if (!sweep_no_cache) so.reference_cache = sweep_cache.empty() ? default_reference_cache_dir().string() : sweep_cache;
       so.engines = sweep_engines;
       so.repetitions = sweep_repetitions;
