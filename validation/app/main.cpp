@@ -19,6 +19,8 @@
 #include "physval/validation/results_json.hpp"
 #include "physval/validation/scenario_loader.hpp"
 #include "physval/validation/suite.hpp"
+#include "physval/validation/reference_cache.hpp"
+#include "physval/validation/scheduler.hpp"
 #include "physval/validation/sweep.hpp"
 
 namespace {
@@ -61,6 +63,9 @@ struct CommonOptions {
   bool no_isolate = false;
   double timeout = 0.0;
   bool quiet = false;
+  int jobs = 0;   // 0: every core
+  std::string cache;
+  bool no_cache = false;
 };
 
 void add_common(CLI::App* cmd, CommonOptions& o) {
@@ -72,6 +77,9 @@ void add_common(CLI::App* cmd, CommonOptions& o) {
   cmd->add_flag("--no-isolate", o.no_isolate, "run engines in this process (debugging; a crash then ends physval)");
   cmd->add_option("--timeout", o.timeout, "seconds a single engine run may take before it is stopped (0: no limit)");
   cmd->add_flag("--quiet", o.quiet, "print only the summary line");
+  cmd->add_option("--cache", o.cache, "reference cache folder (default $XDG_CACHE_HOME/physval/references or ~/.cache/...)");
+  cmd->add_flag("--no-cache", o.no_cache, "compute every reference, read and write no cache");
+  cmd->add_option("-j,--jobs", o.jobs, "references and engine runs at once (default 0: every core); results do not depend on it");
 }
 
 int bad_input(const std::string& message) {
@@ -115,7 +123,9 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
     if (find_engine(e) == nullptr) return bad_input("--engines: no engine named \"" + e + "\" (see `physval engines`)");
   }
   if (!(o.timeout >= 0.0)) return bad_input("--timeout must be a number >= 0");   // also NaN
+  if (o.jobs < 0) return bad_input("--jobs must be >= 0 (0: every core)");
   options.isolate = !o.no_isolate;
+  if (!o.no_cache) options.reference_cache = o.cache.empty() ? default_reference_cache_dir().string() : o.cache;
   options.timeout_seconds = o.timeout;
   nlohmann::json baseline;
   if (!baseline_path.empty()) {
@@ -140,8 +150,10 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
   }
 
   const Progress progress = terminal_progress(o.quiet);
+  const std::size_t jobs = o.jobs > 0 ? static_cast<std::size_t>(o.jobs) : default_jobs();
   SuiteResult result = run_suite(*scenes, o.engines, options, gate,
-                                 progress ? Progress([&](const std::string& l) { progress("running " + l); }) : Progress{});
+                                 progress ? Progress([&](const std::string& l) { progress("running " + l); }) : Progress{},
+                                 jobs);
   end_progress(progress);
   if (!baseline_path.empty()) {
     const int matched = apply_baseline(result, baseline, baseline_factor);
@@ -297,6 +309,12 @@ int main(int argc, char** argv) {
   sweep->add_flag("--no-settings", sweep_no_settings, "sweep step sizes only, each engine at its default settings");
   sweep->add_flag("--quiet", sweep_quiet, "no progress on the terminal");
   double sweep_timeout = 0.0;
+  std::string sweep_cache;
+  bool sweep_no_cache = false;
+  sweep->add_option("--cache", sweep_cache, "reference cache folder (default as for run)");
+  sweep->add_flag("--no-cache", sweep_no_cache, "compute the reference, read and write no cache");
+  int sweep_jobs = 0;
+  sweep->add_option("-j,--jobs", sweep_jobs, "error runs at once (default 0: every core); timing runs are always alone");
   sweep->add_option("--timeout", sweep_timeout, "seconds a single measured run may take before it is stopped (0: no limit)");
 
   std::string report_dir;
@@ -363,6 +381,9 @@ int main(int argc, char** argv) {
       if (sweep_repetitions < 1) return bad_input("--repetitions must be >= 1");
       if (sweep_timeout < 0.0) return bad_input("--timeout must be >= 0");
       so.timeout_seconds = sweep_timeout;
+      if (sweep_jobs < 0) return bad_input("--jobs must be >= 0 (0: every core)");
+      so.jobs = sweep_jobs > 0 ? static_cast<std::size_t>(sweep_jobs) : default_jobs();
+      if (!sweep_no_cache) so.reference_cache = sweep_cache.empty() ? default_reference_cache_dir().string() : sweep_cache;
       so.engines = sweep_engines;
       so.repetitions = sweep_repetitions;
       so.settings = !sweep_no_settings;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -110,17 +111,50 @@ struct ContactMatch {
 };
 
 // Matches contact-begin events pair by pair: each reference contact takes the
-// earliest unmatched run contact of the same pair within `window` seconds.
+// earliest unmatched run contact of the same pair within `window` seconds (earliest in
+// the run's order; the scan of a pair stops at the first of its contacts later than
+// the window). The run's contacts are grouped by pair once, and each pair keeps a
+// cursor past the contacts no later reference contact of that pair can take (used, or
+// earlier than the smallest remaining reference time minus the window), so the cost is
+// about linear in the number of contacts instead of run x reference.
 ContactMatch match_contacts(const std::vector<ContactRecord>& run, const std::vector<ContactRecord>& ref,
                             double window) {
   ContactMatch m;
-  std::vector<bool> used(run.size(), false);
   m.per_reference.resize(ref.size());
+  struct PairQueue {
+    std::vector<std::size_t> run;        // indices into `run`, in the run's order
+    std::size_t cursor = 0;              // run[0..cursor) are dead for this pair
+    std::vector<std::size_t> ref;        // indices into `ref`, in the reference's order
+    std::vector<double> ref_min_after;   // min time of ref[k..] (suffix minimum)
+    std::size_t ref_seen = 0;
+  };
+  std::map<std::pair<std::string, std::string>, PairQueue> pairs;
+  for (std::size_t j = 0; j < run.size(); ++j) pairs[pair_key(run[j].a, run[j].b)].run.push_back(j);
+  std::vector<PairQueue*> ref_queue(ref.size(), nullptr);
   for (std::size_t i = 0; i < ref.size(); ++i) {
-    const auto key = pair_key(ref[i].a, ref[i].b);
+    PairQueue& q = pairs[pair_key(ref[i].a, ref[i].b)];
+    q.ref.push_back(i);
+    ref_queue[i] = &q;
+  }
+  for (auto& [key, q] : pairs) {
+    q.ref_min_after.resize(q.ref.size());
+    double least = std::numeric_limits<double>::infinity();
+    for (std::size_t k = q.ref.size(); k-- > 0;) {
+      least = std::min(least, ref[q.ref[k]].time);
+      q.ref_min_after[k] = least;
+    }
+  }
+  std::vector<bool> used(run.size(), false);
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    PairQueue& q = *ref_queue[i];
+    const double earliest_wanted = q.ref_min_after[q.ref_seen++] - window;
+    while (q.cursor < q.run.size() && (used[q.run[q.cursor]] || run[q.run[q.cursor]].time < earliest_wanted)) {
+      ++q.cursor;
+    }
     std::optional<std::size_t> best;
-    for (std::size_t j = 0; j < run.size(); ++j) {
-      if (used[j] || pair_key(run[j].a, run[j].b) != key) continue;
+    for (std::size_t k = q.cursor; k < q.run.size(); ++k) {
+      const std::size_t j = q.run[k];
+      if (used[j]) continue;
       if (std::abs(run[j].time - ref[i].time) <= window) {
         best = j;
         break;

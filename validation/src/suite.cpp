@@ -1,38 +1,97 @@
 #include "physval/validation/suite.hpp"
 
+#include <algorithm>
+#include <mutex>
 #include <sstream>
+
+#include "physval/validation/reference_cache.hpp"
+#include "physval/validation/scheduler.hpp"
 
 namespace physval {
 
+namespace {
+
+// What a run costs, roughly: body-steps (the reference runs the scene twice at a finer
+// step, so it weighs about twelve runs). Used only to start the longest tasks first.
+double estimated_cost(const Scene& scene) {
+  return static_cast<double>(std::max<std::size_t>(1, scene.bodies.size())) * static_cast<double>(scene.steps());
+}
+
+}  // namespace
+
 SuiteResult run_suite(const std::vector<Scene>& scenes, const std::vector<std::string>& engines,
-                      const RunOptions& options, bool enforce_gates, const Progress& progress) {
+                      const RunOptions& options, bool enforce_gates, const Progress& progress, std::size_t jobs) {
   SuiteResult result;
   result.gates_enforced = enforce_gates;
-  for (const Scene& original : scenes) {
-    ScenarioResult sr;
-    sr.scene = effective_scene(original, options);
-    if (progress) progress(sr.scene.name + ": reference");
-    sr.reference = make_reference(sr.scene, options);
-    for (const EngineFactory* f : engines_for(sr.scene, engines)) {
+  // In-process runs share the process: one at a time.
+  if (!options.isolate) jobs = 1;
+
+  // One task per reference and per engine run; each writes only its own slot.
+  struct Task {
+    std::size_t scenario;
+    const EngineFactory* engine;   // nullptr: the scenario's reference
+    std::size_t slot;
+  };
+  std::vector<Task> tasks;
+  std::vector<double> costs;
+  std::vector<std::vector<const EngineFactory*>> scenario_engines(scenes.size());
+  result.scenarios.resize(scenes.size());
+  for (std::size_t s = 0; s < scenes.size(); ++s) {
+    ScenarioResult& sr = result.scenarios[s];
+    sr.scene = effective_scene(scenes[s], options);
+    const double cost = estimated_cost(sr.scene);
+    tasks.push_back({s, nullptr, 0});
+    costs.push_back(12.0 * cost);
+    scenario_engines[s] = engines_for(sr.scene, engines);
+    sr.runs.resize(scenario_engines[s].size());
+    for (std::size_t e = 0; e < scenario_engines[s].size(); ++e) {
+      const EngineFactory* f = scenario_engines[s][e];
       const std::vector<std::string> missing = unsupported_features(f->info, sr.scene);
-      RunRecord run;
       if (!missing.empty()) {
-        run = unsupported_run(sr.scene, f->info, missing);
-      } else {
-        if (progress) progress(sr.scene.name + ": " + f->info.name);
-        run = run_engine_isolated(sr.scene, *f, options);
+        sr.runs[e] = unsupported_run(sr.scene, f->info, missing);
+        continue;
       }
-      compare_run(run, sr.scene, sr.reference, enforce_gates);
-      sr.runs.push_back(std::move(run));
+      tasks.push_back({s, f, e});
+      costs.push_back(cost);
     }
+  }
+
+  std::mutex progress_mutex;
+  std::size_t started = 0;
+  auto say = [&](const Task& t) {
+    if (!progress) return;
+    const std::lock_guard<std::mutex> lock(progress_mutex);
+    ++started;
+    const std::string what = result.scenarios[t.scenario].scene.name + ": " + (t.engine ? t.engine->info.name : "reference");
+    if (jobs <= 1) return progress(what);
+    std::ostringstream line;
+    line << '[' << started << '/' << tasks.size() << "] " << what;
+    progress(line.str());
+  };
+  run_tasks(costs, jobs, [&](std::size_t i) {
+    const Task& t = tasks[i];
+    ScenarioResult& sr = result.scenarios[t.scenario];
+    say(t);
+    if (t.engine == nullptr) {
+      sr.reference = cached_reference(sr.scene, options).reference;
+    } else {
+      sr.runs[t.slot] = run_engine_isolated(sr.scene, *t.engine, options);
+    }
+  });
+
+  // Comparisons, per scenario (independent of each other).
+  std::vector<double> compare_costs;
+  for (const ScenarioResult& sr : result.scenarios) compare_costs.push_back(static_cast<double>(sr.runs.size()));
+  run_tasks(compare_costs, jobs, [&](std::size_t s) {
+    ScenarioResult& sr = result.scenarios[s];
+    for (RunRecord& run : sr.runs) compare_run(run, sr.scene, sr.reference, enforce_gates);
     for (std::size_t i = 0; i < sr.runs.size(); ++i) {
       for (std::size_t j = i + 1; j < sr.runs.size(); ++j) {
         if (sr.runs[i].status != RunStatus::Ok || sr.runs[j].status != RunStatus::Ok) continue;
         sr.pairs.push_back(compare_pair(sr.runs[i], sr.runs[j], sr.scene));
       }
     }
-    result.scenarios.push_back(std::move(sr));
-  }
+  });
   return result;
 }
 

@@ -8,11 +8,14 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <mutex>
 #include <set>
 #include <stdexcept>
 
 #include "physval/validation/comparator.hpp"
+#include "physval/validation/reference_cache.hpp"
 #include "physval/validation/runner.hpp"
+#include "physval/validation/scheduler.hpp"
 
 namespace physval {
 
@@ -190,11 +193,12 @@ SweepResult run_sweep(const Scene& scene, const SweepOptions& options, const Pro
   // One reference for every point, at least as fine as the finest step swept.
   RunOptions ref_options;
   ref_options.dt = std::min(scene.dt, dts.back());
+  ref_options.reference_cache = options.reference_cache;
   const Scene ref_scene = effective_scene(sampled, ref_options);
   say("sweep " + scene.name + ": building the reference (dt " + dt_label(ref_scene.dt) + ")");
   Reference reference;
   try {
-    reference = make_reference(ref_scene, ref_options);
+    reference = cached_reference(ref_scene, ref_options).reference;
   } catch (const std::exception& e) {
     reference = Reference{};
     reference.reason = e.what();
@@ -236,66 +240,91 @@ SweepResult run_sweep(const Scene& scene, const SweepOptions& options, const Pro
     total += plans.back().variants.size() * dts.size();
   }
 
-  std::size_t done = 0;
+  // Every point first gets its error run, in a child process (up to options.jobs at
+  // once: no timing is taken from them); then the points are timed one after another in
+  // this process, with nothing else of the sweep running, so timing runs never share a
+  // core with each other or with the error runs.
+  struct Work {
+    const EngineFactory* engine;
+    const SweepVariant* variant;
+    double dt;
+    Scene scene;
+    RunOptions ro;
+    std::string what;
+  };
+  std::vector<Work> work;
   for (const Plan& plan : plans) {
-    const EngineFactory& engine = *plan.engine;
     for (const SweepVariant& variant : plan.variants) {
       Scene configured = sampled;
-      for (const auto& [key, value] : variant.options) configured.engine_options[engine.info.name][key] = value;
+      for (const auto& [key, value] : variant.options) configured.engine_options[plan.engine->info.name][key] = value;
       for (double dt : dts) {
-        ++done;
         RunOptions ro;
         ro.dt = dt;
         ro.isolate = false;   // timing runs in this process (no fork in the measurement)
-        const Scene run_scene = effective_scene(configured, ro);
-
-        SweepPoint p;
-        p.engine = engine.info.name;
-        p.setting = variant.label;
-        p.dt = dt;
-        p.steps = run_scene.steps();
-        p.simulated_seconds = static_cast<double>(p.steps) * dt;
-
-        // The first run is measured for error (runs are deterministic) and warms up.
-        const std::string what = "[" + std::to_string(done) + "/" + std::to_string(total) + "] " + engine.info.name +
-                                 (variant.label.empty() ? "" : " " + variant.label) + " dt " + dt_label(dt) + ": ";
-        say(what + "running");
-
-        // The first run, in a child process, is the one measured for error: an engine
-        // that crashes costs its point, not the sweep. Only a run that came back whole
-        // is repeated in this process for timing (engines are deterministic). The
-        // comparison may still find it diverged (energy running away).
-        RunOptions isolated = ro;
-        isolated.isolate = true;
-        isolated.timeout_seconds = options.timeout_seconds;
-        RunRecord first = run_engine_isolated(run_scene, engine, isolated);
-        if (first.status == RunStatus::Ok) {
-          try {
-            compare_run(first, run_scene, reference, false);
-            p.position_error = metric(first, "position_divergence");
-            p.energy_error = metric(first, "energy_divergence");
-            p.contact_time_error = metric(first, "contact_time_error");
-          } catch (const std::exception& e) {
-            first.reason = std::string("comparison failed: ") + e.what();
-          }
-        }
-        p.status = first.status;
-        p.reason = first.reason;
-        p.engine_settings = first.settings;
-        if (p.status == RunStatus::Ok) time_point(p, run_scene, engine, ro, options);
-
-        std::string line = what;
-        if (p.status != RunStatus::Ok) {
-          line += std::string(run_status_name(p.status)) + " (" + p.reason + ")";
-        } else {
-          line += format_seconds(p.wall_per_sim_median) + " s per simulated s";
-          if (p.position_error) line += ", position error " + format_seconds(*p.position_error) + " m";
-          if (p.spread_warning) line += " (timing spread " + std::to_string(static_cast<int>(p.spread * 100)) + "%)";
-        }
-        say(line);
-        result.points.push_back(std::move(p));
+        Scene run_scene = effective_scene(configured, ro);
+        const std::string what = "[" + std::to_string(work.size() + 1) + "/" + std::to_string(total) + "] " +
+                                 plan.engine->info.name + (variant.label.empty() ? "" : " " + variant.label) + " dt " +
+                                 dt_label(dt) + ": ";
+        work.push_back({plan.engine, &variant, dt, std::move(run_scene), ro, what});
       }
     }
+  }
+  std::vector<SweepPoint> points(work.size());
+  std::vector<double> costs;
+  for (const Work& w : work) costs.push_back(static_cast<double>(w.scene.steps()));
+  std::mutex say_mutex;
+  run_tasks(costs, std::max<std::size_t>(1, options.jobs), [&](std::size_t i) {
+    const Work& w = work[i];
+    const EngineFactory& engine = *w.engine;
+    SweepPoint& p = points[i];
+    p.engine = engine.info.name;
+    p.setting = w.variant->label;
+    p.dt = w.dt;
+    p.steps = w.scene.steps();
+    p.simulated_seconds = static_cast<double>(p.steps) * w.dt;
+    {
+      const std::lock_guard<std::mutex> lock(say_mutex);
+      say(w.what + "error run");
+    }
+    // The first run, in a child process, is the one measured for error: an engine
+    // that crashes costs its point, not the sweep. Only a run that came back whole
+    // is repeated in this process for timing (engines are deterministic). The
+    // comparison may still find it diverged (energy running away).
+    RunOptions isolated = w.ro;
+    isolated.isolate = true;
+    isolated.timeout_seconds = options.timeout_seconds;
+    RunRecord first = run_engine_isolated(w.scene, engine, isolated);
+    if (first.status == RunStatus::Ok) {
+      try {
+        compare_run(first, w.scene, reference, false);
+        p.position_error = metric(first, "position_divergence");
+        p.energy_error = metric(first, "energy_divergence");
+        p.contact_time_error = metric(first, "contact_time_error");
+      } catch (const std::exception& e) {
+        first.reason = std::string("comparison failed: ") + e.what();
+      }
+    }
+    p.status = first.status;
+    p.reason = first.reason;
+    p.engine_settings = first.settings;
+  });
+  for (std::size_t i = 0; i < work.size(); ++i) {
+    SweepPoint& p = points[i];
+    const Work& w = work[i];
+    if (p.status == RunStatus::Ok) {
+      say(w.what + "timing");
+      time_point(p, w.scene, *w.engine, w.ro, options);
+    }
+    std::string line = w.what;
+    if (p.status != RunStatus::Ok) {
+      line += std::string(run_status_name(p.status)) + " (" + p.reason + ")";
+    } else {
+      line += format_seconds(p.wall_per_sim_median) + " s per simulated s";
+      if (p.position_error) line += ", position error " + format_seconds(*p.position_error) + " m";
+      if (p.spread_warning) line += " (timing spread " + std::to_string(static_cast<int>(p.spread * 100)) + "%)";
+    }
+    say(line);
+    result.points.push_back(std::move(p));
   }
 
   const auto wide = std::count_if(result.points.begin(), result.points.end(),

@@ -19,6 +19,8 @@ struct RunOptions {
   double timeout_seconds = 0.0;      // per run; 0: none
   // Bound on stored samples x bodies (memory); the sample interval grows to fit.
   std::size_t max_sample_states = 4'000'000;
+  // Folder of the reference cache (see reference_cache.hpp); empty: no cache.
+  std::string reference_cache;
 };
 
 // The scene as it will run: the options' dt and duration applied.

@@ -26,8 +26,11 @@ struct SuiteResult {
 
 using Progress = std::function<void(const std::string& line)>;
 
+// `jobs`: references and engine runs of different scenarios and engines run on this
+// many threads (each engine run is its own process); the result does not depend on it.
 SuiteResult run_suite(const std::vector<Scene>& scenes, const std::vector<std::string>& engines,
-                      const RunOptions& options, bool enforce_gates, const Progress& progress = {});
+                      const RunOptions& options, bool enforce_gates, const Progress& progress = {},
+                      std::size_t jobs = 1);
 
 // 0: everything ran and passed; 1: a check failed or a run diverged / errored.
 int suite_exit_status(const SuiteResult& result);

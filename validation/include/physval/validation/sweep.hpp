@@ -32,6 +32,8 @@ struct SweepOptions {
   double spread_warning = 0.25;       // warn when (max - min) / median exceeds this
   double timeout_seconds = 0.0;       // the first (isolated) run of a point; 0: none. A
                                       // point that times out is an error, not timed.
+  std::string reference_cache;        // reference cache folder (reference_cache.hpp); empty: none
+  std::size_t jobs = 1;               // error runs at once; timing runs always one at a time
 };
 
 // One engine configuration of the sweep: option overrides for the engine's table.

@@ -1,0 +1,60 @@
+// Google Benchmark: the comparator on a contact-heavy pair of runs (a gas of circles
+// with `range(0)` contact events per run, bodies and samples of a 1k-body scene).
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+#include "physval/validation/comparator.hpp"
+
+namespace physval {
+namespace {
+
+RunRecord gas_run(const std::string& engine, std::size_t bodies, std::size_t contacts, std::size_t samples,
+                  unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<std::size_t> body(0, bodies - 1);
+  std::normal_distribution<double> jitter(0.0, 0.002);
+  RunRecord r;
+  r.engine = engine;
+  r.dt = 1.0 / 240.0;
+  r.status = RunStatus::Ok;
+  const double duration = 4.0;
+  for (std::size_t k = 0; k < contacts; ++k) {
+    const std::size_t a = body(rng);
+    const std::size_t b = (a + 1 + body(rng) % (bodies - 1)) % bodies;
+    const double t = duration * static_cast<double>(k) / static_cast<double>(contacts) + jitter(rng);
+    r.contacts.push_back({std::string(1, 'c').append(std::to_string(a)), std::string(1, 'c').append(std::to_string(b)), t, static_cast<long>(t / r.dt)});
+  }
+  for (std::size_t s = 0; s < samples; ++s) {
+    r.series.time.push_back(duration * static_cast<double>(s) / static_cast<double>(samples - 1));
+    Totals t;
+    t.kinetic = 1.0;
+    r.series.totals.push_back(t);
+    std::vector<BodyState> states(bodies);
+    for (std::size_t i = 0; i < bodies; ++i) states[i].position = {static_cast<double>(i), static_cast<double>(s)};
+    r.series.states.push_back(std::move(states));
+  }
+  return r;
+}
+
+void BM_ComparePairContactHeavy(benchmark::State& state) {
+  const auto contacts = static_cast<std::size_t>(state.range(0));
+  const std::size_t bodies = 1000, samples = 100;
+  Scene scene;
+  scene.name = "gas";
+  scene.dt = 1.0 / 240.0;
+  scene.duration = 4.0;
+  const RunRecord a = gas_run("a", bodies, contacts, samples, 1);
+  const RunRecord b = gas_run("b", bodies, contacts, samples, 1);   // same pairs, same times
+  for (auto _ : state) {
+    PairComparison pc = compare_pair(a, b, scene);
+    benchmark::DoNotOptimize(pc);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(contacts));
+}
+BENCHMARK(BM_ComparePairContactHeavy)->Arg(1000)->Arg(10000)->Arg(40000)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace physval
+
+BENCHMARK_MAIN();

@@ -1,0 +1,116 @@
+// Contact matching by pair and time: the indexed matcher in the comparator must give
+// exactly what the plain all-against-all greedy scan gives (kept here as the oracle).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <random>
+
+#include "physval/validation/comparator.hpp"
+
+namespace physval {
+namespace {
+
+struct OracleMatch {
+  std::optional<double> max_error;
+  int missed = 0;
+  int extra = 0;
+};
+
+std::pair<std::string, std::string> ordered(const std::string& a, const std::string& b) {
+  return a < b ? std::pair{a, b} : std::pair{b, a};
+}
+
+// The comparator's rule, written the slow obvious way: each reference contact, in
+// order, takes the earliest unused run contact of its pair within the window; the scan
+// of that pair stops at its first contact later than the window.
+OracleMatch all_against_all(const std::vector<ContactRecord>& run, const std::vector<ContactRecord>& ref,
+                            double window) {
+  OracleMatch m;
+  std::vector<bool> used(run.size(), false);
+  for (const ContactRecord& r : ref) {
+    std::optional<std::size_t> best;
+    for (std::size_t j = 0; j < run.size(); ++j) {
+      if (used[j] || ordered(run[j].a, run[j].b) != ordered(r.a, r.b)) continue;
+      if (std::abs(run[j].time - r.time) <= window) {
+        best = j;
+        break;
+      }
+      if (run[j].time > r.time + window) break;
+    }
+    if (best) {
+      used[*best] = true;
+      m.max_error = std::max(m.max_error.value_or(0.0), std::abs(run[*best].time - r.time));
+    } else {
+      ++m.missed;
+    }
+  }
+  m.extra = static_cast<int>(std::count(used.begin(), used.end(), false));
+  return m;
+}
+
+RunRecord record_with(const std::string& engine, double dt, std::vector<ContactRecord> contacts) {
+  RunRecord r;
+  r.engine = engine;
+  r.dt = dt;
+  r.status = RunStatus::Ok;
+  r.contacts = std::move(contacts);
+  return r;
+}
+
+// Contacts among `bodies` bodies; times mostly increasing with some jitter so that a
+// pair's contacts are sometimes out of order, as an event-driven engine can report them.
+std::vector<ContactRecord> random_contacts(std::mt19937& rng, int count, int bodies, double span, double jitter) {
+  std::uniform_int_distribution<int> body(0, bodies - 1);
+  std::uniform_real_distribution<double> noise(-jitter, jitter);
+  std::vector<ContactRecord> out;
+  for (int k = 0; k < count; ++k) {
+    int a = body(rng), b = body(rng);
+    if (a == b) b = (b + 1) % bodies;
+    const double t = span * k / count + noise(rng);
+    // Both name orders occur: a pair is the same whichever body is named first.
+    if (k % 3 == 0) std::swap(a, b);
+    out.push_back({std::string(1, 'c').append(std::to_string(a)), std::string(1, 'c').append(std::to_string(b)), t, k});
+  }
+  return out;
+}
+
+TEST(ContactMatching, IndexedMatcherEqualsAllAgainstAllOnRandomContacts) {
+  std::mt19937 rng(20261123);
+  Scene scene;
+  scene.name = "contacts";
+  scene.dt = 0.01;
+  int checked_with_misses = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const int bodies = 2 + trial % 7;
+    const double jitter = (trial % 4) * 0.03;
+    const std::vector<ContactRecord> a = random_contacts(rng, 30 + trial * 3, bodies, 5.0, jitter);
+    const std::vector<ContactRecord> b = random_contacts(rng, 25 + trial * 3, bodies, 5.0, jitter);
+    const double dt = 0.002 * (1 + trial % 5);
+    const PairComparison pc = compare_pair(record_with("x", dt, a), record_with("y", dt, b), scene);
+    const OracleMatch want = all_against_all(b, a, std::max(5.0 * dt, 0.05));
+    ASSERT_EQ(pc.metrics.at("missed_contacts"), std::optional<double>(want.missed)) << "trial " << trial;
+    ASSERT_EQ(pc.metrics.at("extra_contacts"), std::optional<double>(want.extra)) << "trial " << trial;
+    ASSERT_EQ(pc.metrics.at("contact_time_error"), want.max_error) << "trial " << trial;
+    if (want.missed > 0 && want.max_error) ++checked_with_misses;
+  }
+  EXPECT_GT(checked_with_misses, 10);   // the trials exercise both matches and misses
+}
+
+TEST(ContactMatching, MatchesSamePairWhicheverNameComesFirstAndCountsTheRest) {
+  Scene scene;
+  scene.name = "contacts";
+  scene.dt = 0.01;
+  const RunRecord ref = record_with("ref", 0.01, {{"a", "b", 1.0, 100}, {"b", "c", 2.0, 200}, {"a", "b", 3.0, 300}});
+  const RunRecord run =
+      record_with("run", 0.01, {{"b", "a", 1.02, 102}, {"a", "c", 2.0, 200}, {"a", "b", 3.0, 300}, {"a", "b", 4.0, 400}});
+  const PairComparison pc = compare_pair(ref, run, scene);
+  EXPECT_EQ(pc.metrics.at("missed_contacts"), std::optional<double>(1));   // (b,c) at 2.0
+  EXPECT_EQ(pc.metrics.at("extra_contacts"), std::optional<double>(2));    // (a,c) and (a,b) at 4.0
+  ASSERT_TRUE(pc.metrics.at("contact_time_error"));
+  EXPECT_NEAR(*pc.metrics.at("contact_time_error"), 0.02, 1e-12);
+}
+
+}  // namespace
+}  // namespace physval
