@@ -52,12 +52,15 @@ std::vector<OptionSpec> box2d_options() {
 
 std::vector<Feature> box2d_features() {
   // Not here: static friction distinct from kinetic (Box2D has one coefficient),
-  // rolling resistance (Box2D 2.4.1 has none), particles (not mapped).
+  // particles (not mapped). Rolling resistance: Box2D 2.4.1 has none, but core's model of
+  // it for bodies that do not spin is Coulomb friction with mu = c, which Box2D's contact
+  // friction expresses (fixed_rotation only; see contact_friction).
   return {Feature::Circles,          Feature::Points,        Feature::StaticBodies,
           Feature::Walls,            Feature::Boxes,         Feature::Surfaces,
           Feature::UniformGravity,   Feature::NewtonianGravity, Feature::LinearDrag,
           Feature::QuadraticDrag,    Feature::Wind,          Feature::Thrust,
-          Feature::Friction,         Feature::MaterialOverrides, Feature::CollisionMatrix};
+          Feature::Friction,         Feature::MaterialOverrides, Feature::CollisionMatrix,
+          Feature::RollingFriction};
 }
 
 b2Vec2 to_b2(Vec2 v) { return {static_cast<float>(v.x), static_cast<float>(v.y)}; }
@@ -148,6 +151,7 @@ void Box2DEngine::load(const Scene& scene) {
     throw std::invalid_argument("box2d cannot model this scene: it uses " + missing.front());
   }
   read_options();
+  adapter::require_fixed_rotation_for_rolling(scene_, opt_.fixed_rotation, "box2d");
   objects_ = std::make_unique<SceneObjects>(scene_);
   forces_ = std::make_unique<ExternalForces>(scene_);
   listener_ = std::make_unique<adapter::Box2DContactListener>(*objects_, opt_.restitution_threshold);
@@ -247,8 +251,16 @@ void Box2DEngine::build_statics() {
     const BoxDef& bx = scene_.boxes[i];
     const Vec2 half = 0.5 * (bx.max - bx.min);
     if (!(half.x > 0.0) || !(half.y > 0.0)) throw std::invalid_argument("box '" + bx.name + "' has no area");
+    // A b2PolygonShape always carries the skin b2_polygonRadius around its vertices: the
+    // core polygon is the scene's box shrunk by the skin, so the faces Box2D collides
+    // with are the scene's faces (corners rounded by the skin, 0.01 m).
+    const double skin = static_cast<double>(b2_polygonRadius);
+    if (!(half.x > skin) || !(half.y > skin)) {
+      throw std::invalid_argument("box '" + bx.name + "' is thinner than twice Box2D's polygon skin (2 x 0.01 m)");
+    }
     b2PolygonShape box;
-    box.SetAsBox(static_cast<float>(half.x), static_cast<float>(half.y), to_b2(0.5 * (bx.min + bx.max)), 0.0f);
+    box.SetAsBox(static_cast<float>(half.x - skin), static_cast<float>(half.y - skin),
+                 to_b2(0.5 * (bx.min + bx.max)), 0.0f);
     add(box, {ObjectRef::Kind::Box, static_cast<std::uint32_t>(i)}, bx.material);
   }
   for (std::size_t i = 0; i < scene_.surfaces.size(); ++i) {
@@ -400,7 +412,12 @@ std::vector<Setting> Box2DEngine::settings() const {
       {"circles", "b2CircleShape"},
       {"points", "b2CircleShape of radius 0"},
       {"walls", "two-sided b2EdgeShape (skin b2_polygonRadius: contact at distance r + 0.01 m)"},
-      {"boxes", "b2PolygonShape box (skin 0.01 m)"},
+      {"boxes", "b2PolygonShape: the scene's box shrunk by the skin 0.01 m, so its faces are the scene's faces "
+                "(corners rounded by 0.01 m)"},
+      {"rolling_friction", "a pair with rolling_friction c > 0 gets contact friction mu = c (core's model for bodies "
+                           "that do not spin); needs fixed_rotation"},
+      {"damping", "0 (b2BodyDef linearDamping and angularDamping)"},
+      {"external_forces_evaluated", "at the start of each step, from the state the previous step left"},
       {"surfaces", "one-sided b2ChainShape facing the scene's normals; ghost vertices extend the end segments"},
       {"collision_matrix", "ignore: b2ContactFilter; event: PreSolve SetEnabled(false); destroy: DestroyBody after the step"},
       {"contact_events", "BeginContact once per physval pair, at the end of the step it fires in"},
