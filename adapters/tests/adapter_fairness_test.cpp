@@ -100,5 +100,34 @@ TEST(BulletSettings, SolverModeFollowsWarmStarting) {
   EXPECT_EQ(setting(e->settings(), "solver_mode"), "SOLVER_SIMD (0x100)");
 }
 
+// tunnelling_thin_wall's layout luck: a 2 cm bullet at 300 m/s, 5 m per 1/60 s step.
+// With the wall at 10 m a step ends touching it and Bullet bounces without continuous
+// collision; at 9.9 m it tunnels with no contact. With ccd on it meets the wall.
+Scene bullet_at_wall(double wall_x) {
+  Scene s = empty_scene("thin_wall", 1.0 / 60.0, 0.1);
+  s.bodies.push_back(circle("bullet", 0.02, 0.01, {0.0, 0.0}, {300.0, 0.0}));
+  s.walls.push_back(wall("plate", {wall_x, -1.0}, {wall_x, 1.0}));
+  return s;
+}
+
+TEST(BulletTunnelling, TenMetresIsLayoutLuckNinePointNineTunnels) {
+  const Scene lucky = bullet_at_wall(10.0);
+  auto e = make_engine("bullet", lucky);
+  EXPECT_EQ(run(*e, lucky, 6).size(), 1u);
+  EXPECT_LT(states(*e)[0].velocity.x, 0.0);
+
+  const Scene offgrid = bullet_at_wall(9.9);
+  auto e2 = make_engine("bullet", offgrid);
+  EXPECT_TRUE(run(*e2, offgrid, 6).empty());
+  EXPECT_EQ(states(*e2)[0].velocity.x, 300.0);   // straight through
+
+  Scene ccd = offgrid;
+  ccd.engine_options["bullet"]["ccd"] = OptionValue{true};
+  ccd.engine_options["bullet"]["contact_processing_threshold"] = OptionValue{1e30};
+  auto e3 = make_engine("bullet", ccd);
+  EXPECT_EQ(run(*e3, ccd, 6).size(), 1u);
+  EXPECT_LT(states(*e3)[0].velocity.x, 0.0);
+}
+
 }  // namespace
 }  // namespace physval::test
