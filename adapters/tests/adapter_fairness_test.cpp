@@ -129,5 +129,33 @@ TEST(BulletTunnelling, TenMetresIsLayoutLuckNinePointNineTunnels) {
   EXPECT_LT(states(*e3)[0].velocity.x, 0.0);
 }
 
+// far_from_origin: m1 = 1 at +2 m/s meets m2 = 3 at -1 m/s a million metres out. At
+// absolute float32 coordinates (positions 0.0625 m apart) Box2D misses the contact;
+// with origin_shift (b2World::ShiftOrigin's advice) it swaps velocities to -2.5 and 0.5.
+Scene head_on_far(bool shift) {
+  Scene s = head_on(1.0, 3.0, 2.0, -1.0, 0.001);
+  for (BodyDef& b : s.bodies) b.position = b.position + Vec2{1e6, 1e6};
+  s.engine_options["box2d"]["origin_shift"] = OptionValue{shift};
+  return s;
+}
+
+TEST(Box2DOriginShift, AbsoluteFloatMissesShiftedOriginCollides) {
+  const Scene absolute = head_on_far(false);
+  auto e = make_engine("box2d", absolute);
+  EXPECT_TRUE(run(*e, absolute, 2000).empty());
+  EXPECT_EQ(setting(e->settings(), "origin_shift"), "false");
+
+  const Scene shifted = head_on_far(true);
+  auto e2 = make_engine("box2d", shifted);
+  EXPECT_EQ(run(*e2, shifted, 2000).size(), 1u);
+  const auto st = states(*e2);
+  EXPECT_NEAR(st[0].velocity.x, -2.5, 1e-5);
+  EXPECT_NEAR(st[1].velocity.x, 0.5, 1e-5);
+  // States come back in scene coordinates, in double.
+  EXPECT_NEAR(st[1].position.y, 1e6, 1e-6);
+  EXPECT_GT(st[1].position.x, 1e6);
+  EXPECT_EQ(setting(e2->settings(), "world_origin"), "(1e+06, 1e+06) in scene coordinates");
+}
+
 }  // namespace
 }  // namespace physval::test
