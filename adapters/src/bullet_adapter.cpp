@@ -82,14 +82,15 @@ std::vector<OptionSpec> bullet_options() {
        "Bodies do not spin (lecture model, collision step 6): angular factor 0. false: spin about z "
        "only, angular factor (0, 0, 1), a uniform disc's inertia 0.5 m r^2."},
       {"contact_processing_threshold", 0.0, {},
-       "Manifold points further apart than this (m) are not solved. Bullet's own (1e18) also solves points "
+       "Manifold points further apart than this (m) are not solved. Bullet's own (BT_LARGE_FLOAT: 1e30 in the double build) also solves points "
        "within its breaking threshold before the bodies touch, with a restitution that treats the gap as "
        "closing this step: an e = 0.5 bounce at 4 m/s left at 1.6 m/s instead of 2. 0: only touching "
        "points are solved."},
       {"contact_begin", std::string("touch"), {"touch", "manifold"},
        "When a pair's contact begins: 'touch' = the first step after which the pair's manifold has a point "
        "at distance <= 0 or a normal impulse > 0; 'manifold' = its first manifold point at all "
-       "(gContactStartedCallback), which Bullet creates up to its breaking threshold before touching. "
+       "(physval scans the manifolds after each step), which Bullet creates up to its breaking threshold "
+       "before touching. Not gContactStartedCallback: that fires every step for a resting sphere. "
        "Bullet writes impulses back only with warm starting; without it 'touch' means distance <= 0."},
   };
 }
@@ -226,7 +227,7 @@ void BulletEngine::read_options() {
     // Bullet's continuous collision works through predictive contacts: points at a
     // positive distance, which a threshold of 0 would never solve.
     throw std::invalid_argument(
-        "bullet.ccd = true needs bullet.contact_processing_threshold > 0 (e.g. 1e18, Bullet's own): "
+        "bullet.ccd = true needs bullet.contact_processing_threshold > 0 (e.g. 1e30, Bullet's own BT_LARGE_FLOAT in the double build): "
         "its predictive contacts are points before touching");
   }
   if (std::isnan(opt_.split_impulse_threshold)) throw std::invalid_argument("bullet.split_impulse_threshold is NaN");
