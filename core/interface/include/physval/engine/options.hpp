@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "physval/core/scene.hpp"
+#include "physval/engine/scene.hpp"
 
 namespace physval {
 
