@@ -47,6 +47,10 @@ std::vector<OptionSpec> box2d_options() {
        "Approach speed (m/s) below which a contact does not bounce. Box2D's own default is 1 m/s; "
        "physval's 0 keeps an elastic scene elastic.",
        OptionRange::at_least(0)},
+      {"origin_shift", false, {},
+       "false: float32 at the scene's absolute coordinates. true: Box2D used as its documentation advises for "
+       "large worlds (b2World::ShiftOrigin): the world's origin moves to the centre of the moving bodies' "
+       "starting box, objects are built at (x - origin) and states read back as (x + origin), both in double."},
       {"fixed_rotation", true, {},
        "Bodies do not spin (lecture model, collision step 6): b2BodyDef::fixedRotation. false: a "
        "circle has a uniform disc's inertia 0.5 m r^2 and friction can spin it."},
@@ -55,12 +59,15 @@ std::vector<OptionSpec> box2d_options() {
 
 std::vector<Feature> box2d_features() {
   // Not here: static friction distinct from kinetic (Box2D has one coefficient),
-  // rolling resistance (Box2D 2.4.1 has none), particles (not mapped).
+  // particles (not mapped). Rolling resistance: Box2D 2.4.1 has none, but core's model of
+  // it for bodies that do not spin is Coulomb friction with mu = c, which Box2D's contact
+  // friction expresses (fixed_rotation only; see contact_friction).
   return {Feature::Circles,          Feature::Points,        Feature::StaticBodies,
           Feature::Walls,            Feature::Boxes,         Feature::Surfaces,
           Feature::UniformGravity,   Feature::NewtonianGravity, Feature::LinearDrag,
           Feature::QuadraticDrag,    Feature::Wind,          Feature::Thrust,
-          Feature::Friction,         Feature::MaterialOverrides, Feature::CollisionMatrix};
+          Feature::Friction,         Feature::MaterialOverrides, Feature::CollisionMatrix,
+          Feature::RollingFriction};
 }
 
 b2Vec2 to_b2(Vec2 v) { return {static_cast<float>(v.x), static_cast<float>(v.y)}; }
@@ -78,6 +85,7 @@ struct Box2DOptions {
   bool warm_starting = true;
   float restitution_threshold = 0.0f;
   bool fixed_rotation = true;
+  bool origin_shift = false;
 };
 
 class Box2DEngine final : public Engine {
@@ -102,6 +110,9 @@ class Box2DEngine final : public Engine {
   void apply_external_forces();
   void destroy_bodies();
   void check_limits(double dt);
+  // Scene coordinates to Box2D's and back, through the world origin (origin_shift).
+  b2Vec2 to_world(Vec2 p) const { return to_b2(p - origin_); }
+  Vec2 from_world(b2Vec2 p) const { return from_b2(p) + origin_; }
 
   EngineInfo info_;
   Scene scene_;
@@ -116,6 +127,7 @@ class Box2DEngine final : public Engine {
   // between moving bodies can miss a contact: its radius plus the smallest other moving
   // body's (infinite: no other moving body it could meet). Static shapes are swept.
   std::vector<double> tunnel_size_;
+  Vec2 origin_;   // where Box2D's origin sits in scene coordinates; 0 without origin_shift
   double time_ = 0.0;
   std::vector<ContactEvent> contacts_;
   LimitMonitor limits_;
@@ -140,6 +152,23 @@ void Box2DEngine::read_options() {
   }
   opt_.restitution_threshold = static_cast<float>(threshold);
   opt_.fixed_rotation = r.get_bool("fixed_rotation");
+  opt_.origin_shift = r.get_bool("origin_shift");
+}
+
+// The centre of the moving bodies' starting bounding box (0 without origin_shift or
+// moving bodies): the origin b2World::ShiftOrigin would give a world that follows them.
+Vec2 shifted_origin(const Scene& scene, bool shift) {
+  if (!shift) return {};
+  Vec2 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  Vec2 hi = -1.0 * lo;
+  bool any = false;
+  for (const BodyDef& b : scene.bodies) {
+    if (b.is_static) continue;
+    lo = {std::min(lo.x, b.position.x), std::min(lo.y, b.position.y)};
+    hi = {std::max(hi.x, b.position.x), std::max(hi.y, b.position.y)};
+    any = true;
+  }
+  return any ? 0.5 * (lo + hi) : Vec2{};
 }
 
 void Box2DEngine::load(const Scene& scene) {
@@ -151,10 +180,12 @@ void Box2DEngine::load(const Scene& scene) {
     throw std::invalid_argument("box2d cannot model this scene: it uses " + missing.front());
   }
   read_options();
+  adapter::require_fixed_rotation_for_rolling(scene_, opt_.fixed_rotation, "box2d");
   objects_ = std::make_unique<SceneObjects>(scene_);
   forces_ = std::make_unique<ExternalForces>(scene_);
   listener_ = std::make_unique<adapter::Box2DContactListener>(*objects_, opt_.restitution_threshold);
 
+  origin_ = shifted_origin(scene_, opt_.origin_shift);
   world_ = std::make_unique<b2World>(to_b2(scene_.world.gravity));
   world_->SetAllowSleeping(false);   // a slow body must never freeze (engines.md)
   world_->SetWarmStarting(opt_.warm_starting);
@@ -187,7 +218,7 @@ void Box2DEngine::build_bodies() {
     const BodyDef& b = scene_.bodies[i];
     b2BodyDef bd;
     bd.type = b.is_static ? b2_staticBody : b2_dynamicBody;
-    bd.position = to_b2(b.position);
+    bd.position = to_world(b.position);
     bd.angle = static_cast<float>(b.angle);
     if (!b.is_static) {
       bd.linearVelocity = to_b2(b.velocity);
@@ -243,15 +274,23 @@ void Box2DEngine::build_statics() {
       throw std::invalid_argument("wall '" + w.name + "' is shorter than Box2D's linear slop (0.005 m)");
     }
     b2EdgeShape edge;   // two-sided; Box2D thickens it by its skin b2_polygonRadius
-    edge.SetTwoSided(to_b2(w.from), to_b2(w.to));
+    edge.SetTwoSided(to_world(w.from), to_world(w.to));
     add(edge, {ObjectRef::Kind::Wall, static_cast<std::uint32_t>(i)}, w.material);
   }
   for (std::size_t i = 0; i < scene_.boxes.size(); ++i) {
     const BoxDef& bx = scene_.boxes[i];
     const Vec2 half = 0.5 * (bx.max - bx.min);
     if (!(half.x > 0.0) || !(half.y > 0.0)) throw std::invalid_argument("box '" + bx.name + "' has no area");
+    // A b2PolygonShape always carries the skin b2_polygonRadius around its vertices: the
+    // core polygon is the scene's box shrunk by the skin, so the faces Box2D collides
+    // with are the scene's faces (corners rounded by the skin, 0.01 m).
+    const double skin = static_cast<double>(b2_polygonRadius);
+    if (!(half.x > skin) || !(half.y > skin)) {
+      throw std::invalid_argument("box '" + bx.name + "' is thinner than twice Box2D's polygon skin (2 x 0.01 m)");
+    }
     b2PolygonShape box;
-    box.SetAsBox(static_cast<float>(half.x), static_cast<float>(half.y), to_b2(0.5 * (bx.min + bx.max)), 0.0f);
+    box.SetAsBox(static_cast<float>(half.x - skin), static_cast<float>(half.y - skin),
+                 to_world(0.5 * (bx.min + bx.max)), 0.0f);
     add(box, {ObjectRef::Kind::Box, static_cast<std::uint32_t>(i)}, bx.material);
   }
   for (std::size_t i = 0; i < scene_.surfaces.size(); ++i) {
@@ -275,7 +314,7 @@ void Box2DEngine::build_statics() {
                                   "': its normals face both sides; a Box2D chain is one-sided");
     }
     std::vector<b2Vec2> v;
-    for (const Vec2& p : s.points) v.push_back(to_b2(p));
+    for (const Vec2& p : s.points) v.push_back(to_world(p));
     if (left > 0) std::reverse(v.begin(), v.end());
     // Ghost vertices continue the end segments straight, so the ends are smooth.
     const b2Vec2 prev = v[0] + (v[0] - v[1]);
@@ -312,7 +351,7 @@ void Box2DEngine::destroy_bodies() {
   for (std::uint32_t i : listener_->take_destroyed()) {
     if (i >= bodies_.size() || bodies_[i] == nullptr) continue;
     const b2Body* b = bodies_[i];
-    final_states_[i] = {from_b2(b->GetPosition()), from_b2(b->GetLinearVelocity()),
+    final_states_[i] = {from_world(b->GetPosition()), from_b2(b->GetLinearVelocity()),
                         static_cast<double>(b->GetAngle()), static_cast<double>(b->GetAngularVelocity()), false};
     world_->DestroyBody(bodies_[i]);
     bodies_[i] = nullptr;
@@ -371,7 +410,7 @@ void Box2DEngine::read_states(std::vector<BodyState>& out) const {
       out[i] = final_states_[i];
       continue;
     }
-    out[i] = {from_b2(b->GetPosition()), from_b2(b->GetLinearVelocity()), static_cast<double>(b->GetAngle()),
+    out[i] = {from_world(b->GetPosition()), from_b2(b->GetLinearVelocity()), static_cast<double>(b->GetAngle()),
               static_cast<double>(b->GetAngularVelocity()), true};
   }
 }
@@ -394,6 +433,8 @@ std::vector<Setting> Box2DEngine::settings() const {
       {"allow_sleeping", "false"},
       {"restitution_threshold", fmt(static_cast<double>(opt_.restitution_threshold))},
       {"fixed_rotation", b(opt_.fixed_rotation)},
+      {"origin_shift", b(opt_.origin_shift)},
+      {"world_origin", "(" + fmt(origin_.x) + ", " + fmt(origin_.y) + ") in scene coordinates"},
       {"material_rule",
        "PreSolve sets every contact's restitution min(e1, e2), friction sqrt(f1 f2), per-pair overrides "
        "(Box2D's own mixing: restitution max)"},
@@ -403,7 +444,12 @@ std::vector<Setting> Box2DEngine::settings() const {
       {"circles", "b2CircleShape"},
       {"points", "b2CircleShape of radius 0"},
       {"walls", "two-sided b2EdgeShape (skin b2_polygonRadius: contact at distance r + 0.01 m)"},
-      {"boxes", "b2PolygonShape box (skin 0.01 m)"},
+      {"boxes", "b2PolygonShape: the scene's box shrunk by the skin 0.01 m, so its faces are the scene's faces "
+                "(corners rounded by 0.01 m)"},
+      {"rolling_friction", "a pair with rolling_friction c > 0 gets contact friction mu = c (core's model for bodies "
+                           "that do not spin); needs fixed_rotation"},
+      {"damping", "0 (b2BodyDef linearDamping and angularDamping)"},
+      {"external_forces_evaluated", "at the start of each step, from the state the previous step left"},
       {"surfaces", "one-sided b2ChainShape facing the scene's normals; ghost vertices extend the end segments"},
       {"collision_matrix", "ignore: b2ContactFilter; event: PreSolve SetEnabled(false); destroy: DestroyBody after the step"},
       {"contact_events", "BeginContact once per physval pair, at the end of the step it fires in"},

@@ -53,7 +53,7 @@ void Box2DContactListener::PreSolve(b2Contact* contact, const b2Manifold* /*old_
   // Box2D mixes restitution as max(e1, e2); physval's rule replaces it on every contact.
   const PairMaterial m = objects_.pair_material(a, b);
   contact->SetRestitution(static_cast<float>(m.restitution));
-  contact->SetFriction(static_cast<float>(m.friction));
+  contact->SetFriction(static_cast<float>(objects_.contact_friction(a, b)));   // rolling_friction: mu = c
   contact->SetRestitutionThreshold(restitution_threshold_);
 }
 

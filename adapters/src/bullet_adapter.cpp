@@ -11,6 +11,7 @@
 #include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "bullet_callbacks.hpp"
 #include "bullet_includes.hpp"
@@ -89,7 +90,7 @@ std::vector<OptionSpec> bullet_options() {
        "Bodies do not spin (lecture model, collision step 6): angular factor 0. false: spin about z "
        "only, angular factor (0, 0, 1), a uniform disc's inertia 0.5 m r^2."},
       {"contact_processing_threshold", 0.0, {},
-       "Manifold points further apart than this (m) are not solved. Bullet's own (1e18) also solves points "
+       "Manifold points further apart than this (m) are not solved. Bullet's own (BT_LARGE_FLOAT: 1e30 in the double build) also solves points "
        "within its breaking threshold before the bodies touch, with a restitution that treats the gap as "
        "closing this step: an e = 0.5 bounce at 4 m/s left at 1.6 m/s instead of 2. 0: only touching "
        "points are solved.",
@@ -97,19 +98,23 @@ std::vector<OptionSpec> bullet_options() {
       {"contact_begin", std::string("touch"), {"touch", "manifold"},
        "When a pair's contact begins: 'touch' = the first step after which the pair's manifold has a point "
        "at distance <= 0 or a normal impulse > 0; 'manifold' = its first manifold point at all "
-       "(gContactStartedCallback), which Bullet creates up to its breaking threshold before touching. "
+       "(physval scans the manifolds after each step), which Bullet creates up to its breaking threshold "
+       "before touching. Not gContactStartedCallback: that fires every step for a resting sphere. "
        "Bullet writes impulses back only with warm starting; without it 'touch' means distance <= 0."},
   };
 }
 
 std::vector<Feature> bullet_features() {
-  // Not here: static friction distinct from kinetic (one coefficient), rolling resistance
-  // (Bullet's rolling friction acts on spin, and physval bodies do not spin), particles.
+  // Not here: static friction distinct from kinetic (one coefficient), particles.
+  // Rolling resistance is not Bullet's rolling friction (that acts on spin, and physval
+  // bodies do not spin): core's model of it for bodies that do not spin is Coulomb
+  // friction with mu = c, which the friction callback imposes (fixed_rotation only).
   return {Feature::Circles,          Feature::Points,        Feature::StaticBodies,
           Feature::Walls,            Feature::Boxes,         Feature::Surfaces,
           Feature::UniformGravity,   Feature::NewtonianGravity, Feature::LinearDrag,
           Feature::QuadraticDrag,    Feature::Wind,          Feature::Thrust,
-          Feature::Friction,         Feature::MaterialOverrides, Feature::CollisionMatrix};
+          Feature::Friction,         Feature::MaterialOverrides, Feature::CollisionMatrix,
+          Feature::RollingFriction};
 }
 
 btVector3 to_bt(Vec2 v) { return {static_cast<btScalar>(v.x), static_cast<btScalar>(v.y), 0.0}; }
@@ -231,7 +236,7 @@ void BulletEngine::read_options() {
     // Bullet's continuous collision works through predictive contacts: points at a
     // positive distance, which a threshold of 0 would never solve.
     throw std::invalid_argument(
-        "bullet.ccd = true needs bullet.contact_processing_threshold > 0 (e.g. 1e18, Bullet's own): "
+        "bullet.ccd = true needs bullet.contact_processing_threshold > 0 (e.g. 1e30, Bullet's own BT_LARGE_FLOAT in the double build): "
         "its predictive contacts are points before touching");
   }
   if (std::isnan(opt_.split_impulse_threshold)) throw std::invalid_argument("bullet.split_impulse_threshold is NaN");
@@ -262,6 +267,7 @@ void BulletEngine::load(const Scene& scene) {
     throw std::invalid_argument("bullet cannot model this scene: it uses " + missing.front());
   }
   read_options();
+  adapter::require_fixed_rotation_for_rolling(scene_, opt_.fixed_rotation, "bullet");
   objects_ = std::make_unique<SceneObjects>(scene_);
   forces_ = std::make_unique<ExternalForces>(scene_);
   adapter::install_material_callbacks();
@@ -537,8 +543,36 @@ void BulletEngine::read_states(std::vector<BodyState>& out) const {
   }
 }
 
+// The solver-mode flags as names, e.g. "SOLVER_USE_WARMSTARTING | SOLVER_SIMD (0x104)".
+std::string solver_mode_names(int mode) {
+  static const std::pair<int, const char*> kFlags[] = {
+      {SOLVER_RANDMIZE_ORDER, "SOLVER_RANDMIZE_ORDER"},
+      {SOLVER_FRICTION_SEPARATE, "SOLVER_FRICTION_SEPARATE"},
+      {SOLVER_USE_WARMSTARTING, "SOLVER_USE_WARMSTARTING"},
+      {SOLVER_USE_2_FRICTION_DIRECTIONS, "SOLVER_USE_2_FRICTION_DIRECTIONS"},
+      {SOLVER_ENABLE_FRICTION_DIRECTION_CACHING, "SOLVER_ENABLE_FRICTION_DIRECTION_CACHING"},
+      {SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION, "SOLVER_DISABLE_VELOCITY_DEPENDENT_FRICTION_DIRECTION"},
+      {SOLVER_CACHE_FRIENDLY, "SOLVER_CACHE_FRIENDLY"},
+      {SOLVER_SIMD, "SOLVER_SIMD"},
+      {SOLVER_INTERLEAVE_CONTACT_AND_FRICTION_CONSTRAINTS, "SOLVER_INTERLEAVE_CONTACT_AND_FRICTION_CONSTRAINTS"},
+      {SOLVER_ALLOW_ZERO_LENGTH_FRICTION_DIRECTIONS, "SOLVER_ALLOW_ZERO_LENGTH_FRICTION_DIRECTIONS"},
+      {SOLVER_DISABLE_IMPLICIT_CONE_FRICTION, "SOLVER_DISABLE_IMPLICIT_CONE_FRICTION"},
+      {SOLVER_USE_ARTICULATED_WARMSTARTING, "SOLVER_USE_ARTICULATED_WARMSTARTING"},
+  };
+  std::string out;
+  for (const auto& [flag, name] : kFlags) {
+    if ((mode & flag) != 0) out += (out.empty() ? "" : " | ") + std::string(name);
+  }
+  std::ostringstream hex;
+  hex << " (0x" << std::hex << mode << ")";
+  return (out.empty() ? std::string("0") : out) + hex.str();
+}
+
 std::vector<Setting> BulletEngine::settings() const {
   auto b = [](bool v) { return std::string(v ? "true" : "false"); };
+  // The solver's own values as the world holds them (Bullet's defaults before a load).
+  btContactSolverInfo defaults;
+  const btContactSolverInfo& si = world_ ? world_->getSolverInfo() : defaults;
   return {
       {"version", bullet_version()},
       {"runtime_version", std::to_string(btGetVersion())},
@@ -560,6 +594,15 @@ std::vector<Setting> BulletEngine::settings() const {
       {"fixed_rotation", b(opt_.fixed_rotation)},
       {"contact_processing_threshold", fmt(opt_.contact_processing_threshold)},
       {"contact_begin", opt_.begin_at_manifold ? "manifold" : "touch"},
+      {"solver_mode", solver_mode_names(si.m_solverMode)},
+      {"linear_slop", fmt(static_cast<double>(si.m_linearSlop)) + " m (btContactSolverInfo::m_linearSlop)"},
+      {"global_cfm", fmt(static_cast<double>(si.m_globalCfm)) + " (btContactSolverInfo::m_globalCfm)"},
+      {"static_half_depth_z", fmt(static_cast<double>(kHalfDepthZ)) +
+                                  " m: walls, boxes and surfaces are btBoxShapes extruded +-this along z"},
+      {"damping", "0 (btRigidBodyConstructionInfo linear and angular damping)"},
+      {"external_forces_evaluated", "at the start of each step, from the state the previous step left"},
+      {"rolling_friction", "a pair with rolling_friction c > 0 gets contact friction mu = c (core's model for bodies "
+                           "that do not spin), not Bullet's spin-based rolling friction; needs fixed_rotation"},
       {"deactivation", "DISABLE_DEACTIVATION on every dynamic body"},
       {"plane", "linear factor (1, 1, 0); angular factor " + std::string(opt_.fixed_rotation ? "0" : "(0, 0, 1)")},
       {"material_rule",
@@ -570,7 +613,7 @@ std::vector<Setting> BulletEngine::settings() const {
       {"mass", "the scene's mass; inertia 0.5 m r^2 about z"},
       {"circles", "btSphereShape (margin = radius)"},
       {"points", "btSphereShape of radius 0"},
-      {"walls", "btBoxShape: segment core, margin = wall_half_thickness, extruded +-1 m along z"},
+      {"walls", "btBoxShape: segment core, margin = wall_half_thickness, extruded +-static_half_depth_z along z"},
       {"boxes", "btBoxShape, margin = box_margin"},
       {"surfaces", "one btBoxShape per segment, surface_depth deep behind the surface"},
       {"collision_matrix",

@@ -24,7 +24,7 @@ btScalar combined_friction(const btCollisionObject* a, const btCollisionObject* 
     const btScalar f = a->getFriction() * b->getFriction();   // Bullet's own rule, clamped at 10
     return btClamped(f, btScalar(-10.0), btScalar(10.0));
   }
-  return static_cast<btScalar>(ta->objects->pair_material(ta->ref, tb->ref).friction);
+  return static_cast<btScalar>(ta->objects->contact_friction(ta->ref, tb->ref));   // rolling_friction: mu = c
 }
 
 }  // namespace

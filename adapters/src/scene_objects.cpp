@@ -1,6 +1,7 @@
 #include "scene_objects.hpp"
 
 #include <stdexcept>
+#include <string>
 
 namespace physval::adapter {
 
@@ -16,6 +17,17 @@ bool order_pair(ObjectRef x, ObjectRef y, ObjectRef& a, ObjectRef& b) {
     b = x_body ? y : x;
   }
   return true;
+}
+
+void require_fixed_rotation_for_rolling(const Scene& scene, bool fixed_rotation, const char* engine) {
+  if (fixed_rotation) return;
+  for (const Feature f : scene_features(scene)) {
+    if (f == Feature::RollingFriction) {
+      throw std::invalid_argument(std::string(engine) +
+                                  ": rolling_friction is mapped to contact friction mu = c for bodies that do not "
+                                  "spin; it needs " + engine + ".fixed_rotation = true");
+    }
+  }
 }
 
 PairKey pair_key(ObjectRef a, ObjectRef b) { return {pack(a), pack(b)}; }

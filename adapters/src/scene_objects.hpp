@@ -32,6 +32,11 @@ struct PairKey {
 bool order_pair(ObjectRef x, ObjectRef y, ObjectRef& a, ObjectRef& b);
 PairKey pair_key(ObjectRef a, ObjectRef b);   // of an ordered pair
 
+// An engine maps rolling_friction to contact friction mu = c only for bodies that do
+// not spin; with rotation on, that friction would make a wheel roll free. Throws
+// invalid_argument naming the engine's option otherwise.
+void require_fixed_rotation_for_rolling(const Scene& scene, bool fixed_rotation, const char* engine);
+
 class SceneObjects {
  public:
   explicit SceneObjects(const Scene& scene) : scene_(scene) {}
@@ -43,6 +48,14 @@ class SceneObjects {
   // physval's one material rule (scene.hpp), the same for every engine.
   PairMaterial pair_material(ObjectRef a, ObjectRef b) const {
     return combine_materials(scene_, material(a), material(b));
+  }
+  // The one friction coefficient an engine's contact gets. core models a pair with
+  // rolling_friction c > 0, for bodies that do not spin, as Coulomb friction with
+  // mu_s = mu_k = c (resting_contact.cpp); an engine expresses exactly that through its
+  // contact friction. Otherwise the kinetic coefficient (engines have one coefficient).
+  double contact_friction(ObjectRef a, ObjectRef b) const {
+    const PairMaterial m = pair_material(a, b);
+    return m.rolling_friction > 0.0 ? m.rolling_friction : m.friction;
   }
   // What the collision matrix says happens between a and b (destroy_first names a).
   PairResponse response(ObjectRef a, ObjectRef b) const {

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "physval/core/scene.hpp"
+#include "physval/engine/scene.hpp"
 
 namespace physval {
 

@@ -1,4 +1,4 @@
-#include "physval/core/options.hpp"
+#include "physval/engine/options.hpp"
 
 #include <cmath>
 #include <sstream>

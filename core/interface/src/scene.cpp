@@ -1,4 +1,4 @@
-#include "physval/core/scene.hpp"
+#include "physval/engine/scene.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -14,7 +14,7 @@
 #include <variant>
 #include <vector>
 
-#include "physval/core/vec2.hpp"
+#include "physval/engine/vec2.hpp"
 
 namespace physval {
 

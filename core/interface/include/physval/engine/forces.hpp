@@ -9,8 +9,8 @@
 #include <cstddef>
 #include <span>
 
-#include "physval/core/scene.hpp"
-#include "physval/core/vec2.hpp"
+#include "physval/engine/scene.hpp"
+#include "physval/engine/vec2.hpp"
 
 namespace physval {
 

@@ -1,4 +1,4 @@
-#include "physval/core/engine.hpp"
+#include "physval/engine/engine.hpp"
 
 #include <algorithm>
 

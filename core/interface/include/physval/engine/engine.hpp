@@ -10,9 +10,9 @@
 #include <utility>
 #include <vector>
 
-#include "physval/core/options.hpp"
-#include "physval/core/scene.hpp"
-#include "physval/core/vec2.hpp"
+#include "physval/engine/options.hpp"
+#include "physval/engine/scene.hpp"
+#include "physval/engine/vec2.hpp"
 
 namespace physval {
 

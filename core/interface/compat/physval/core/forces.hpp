@@ -1,0 +1,3 @@
+// Forwarding header: the engine interface lives in core/interface (target physval::engine_api).
+#pragma once
+#include "physval/engine/forces.hpp"
