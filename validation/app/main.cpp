@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <sstream>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "physval/adapters/registry.hpp"
 #include "physval/validation/console_table.hpp"
 #include "physval/validation/gate.hpp"
+#include "physval/validation/known_failures.hpp"
 #include "physval/validation/plot.hpp"
 #include "physval/validation/report.hpp"
 #include "physval/validation/results_json.hpp"
@@ -108,8 +110,25 @@ void end_progress(const Progress& progress) {
   if (progress) std::cerr << "\r\033[K" << std::flush;
 }
 
+// `gate --record-known F`: writes each engine's misses, F x the measured error, into
+// the scenario files' [gate.<engine>] known_failures.
+void record_known_failures(const SuiteResult& result, double margin) {
+  for (const ScenarioResult& sr : result.scenarios) {
+    const std::string& file = sr.scene.source_file;
+    std::ifstream in(file);
+    if (!in) throw std::runtime_error(file + ": cannot read it to record known failures");
+    std::stringstream text;
+    text << in.rdbuf();
+    const std::string before = text.str();
+    const std::string after = rewrite_known_failures(before, measured_known_failures(sr, margin));
+    if (after == before) continue;
+    write_file_atomically(file, after);
+    std::cout << "known failures recorded: " << file << '\n';
+  }
+}
+
 int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, const std::string& baseline_path,
-                double baseline_factor, bool report) {
+                double baseline_factor, bool report, double record_known = 0.0) {
   RunOptions options;
   if (!o.dt.empty()) {
     options.dt = parse_seconds(o.dt);
@@ -160,6 +179,14 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
     std::cout << "baseline: " << matched << " runs matched in " << baseline_path << " (regression factor "
               << baseline_factor << ")\n";
     if (matched == 0) return bad_input(baseline_path + ": the baseline matches no run (scenario and engine): nothing compared");
+  }
+  if (record_known > 0.0) {
+    try {
+      record_known_failures(result, record_known);
+    } catch (const std::exception& e) {
+      std::cerr << "physval: " << e.what() << '\n';
+      return kExitBadInput;
+    }
   }
   if (gate) {
     std::size_t checked = 0;
@@ -286,6 +313,10 @@ int main(int argc, char** argv) {
   gate->add_option("--baseline", baseline, "an earlier results.json: fail on a regression beyond --baseline-factor");
   gate->add_option("--baseline-factor", baseline_factor, "how much worse than the baseline an error metric may get")
       ->capture_default_str();
+  double record_known = 0.0;
+  gate->add_option("--record-known", record_known,
+                   "write every expectation an engine misses into the scenario file's [gate.<engine>] "
+                   "known_failures, with this factor (>= 1) times the measured error as its bound");
   bool gate_report = false;
   gate->add_flag("--report", gate_report, "also write DIR/report.html with plots");
 
@@ -348,7 +379,12 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*run) return run_or_gate(run_opts, false, "", "", 2.0, run_report);
-    if (*gate) return run_or_gate(gate_opts, true, junit, baseline, baseline_factor, gate_report);
+    if (*gate) {
+      if (record_known != 0.0 && !(record_known >= 1.0 && std::isfinite(record_known))) {
+        return bad_input("--record-known: the margin must be a finite number >= 1");
+      }
+      return run_or_gate(gate_opts, true, junit, baseline, baseline_factor, gate_report, record_known);
+    }
     if (*report) {
       if (!std::filesystem::exists(std::filesystem::path(report_dir) / "results.json")) {
         return bad_input(report_dir + ": no results.json here (write one with `physval run PATH --out " + report_dir + "`)");

@@ -73,6 +73,7 @@ json run_to_json(const RunRecord& r) {
   json checks = json::array();
   for (const Check& c : r.checks) {
     checks.push_back({{"what", c.what}, {"limit", c.limit}, {"value", opt(c.value)}, {"pass", c.pass}, {"enforced", c.enforced}});
+    if (c.known_failure) checks.back()["known_failure"] = true;
   }
   json settings = json::object();
   for (const auto& [k, v] : r.settings) settings[k] = v;

@@ -497,6 +497,15 @@ void read_gate_limits(TableReader& r, std::map<std::string, double>& limits,
   for (auto&& [k, v] : r.table()) {
     const std::string key(k.str());
     if (is_subtable(key)) continue;
+    if (key == "known_failures") continue;  // read by read_known_failures
+    if (key == "expectation_failures") {
+      r.mark_used(key);
+      r.error_at(v, key,
+                 "a count of allowed misses lets any new miss pass; name them instead: "
+                 "known_failures = { \"expect.final.a.velocity\" = <largest error accepted> } "
+                 "(`physval gate PATH --record-known 2` writes them from a run)");
+      continue;
+    }
     if (!is_metric_name(key)) continue;  // left unused: finish() reports it as unknown
     r.mark_used(key);
     if (auto n = r.to_number(v, r.key_path(key))) {
@@ -504,6 +513,33 @@ void read_gate_limits(TableReader& r, std::map<std::string, double>& limits,
         r.error_at(v, key, "a limit must be >= 0, got " + format_number(*n));
       } else {
         limits[key] = *n;
+      }
+    }
+  }
+}
+
+void read_known_failures(TableReader& r, std::map<std::string, double>& known) {
+  const toml::node* n = r.node("known_failures");
+  if (n == nullptr) return;
+  const toml::table* t = n->as_table();
+  if (t == nullptr) {
+    r.error_at(*n, "known_failures", "expected a table of expectation check names and the largest error accepted");
+    return;
+  }
+  for (auto&& [k, v] : *t) {
+    const std::string name(k.str());
+    const std::string kp = r.key_path("known_failures") + ".\"" + name + "\"";
+    if (name.rfind("expect.", 0) != 0) {
+      r.error_at(v, "known_failures", "\"" + name + "\" is not an expectation check (they are named expect.*)");
+      continue;
+    }
+    if (const auto* s = v.as_string(); s != nullptr && s->get() == "not measured") {
+      known[name] = GateDef::kKnownNotMeasured;
+    } else if (auto b = r.to_number(v, kp)) {
+      if (!(*b >= 0.0)) {
+        r.error_at(v, "known_failures", "the bound for \"" + name + "\" must be >= 0, got " + format_number(*b));
+      } else {
+        known[name] = *b;
       }
     }
   }
@@ -517,6 +553,7 @@ void read_gate(Context& ctx, const toml::table& t, GateDef& g) {
     if (const toml::table* sub = r.subtable(f.info.name)) {
       TableReader er(ctx, *sub, "gate." + f.info.name);
       read_gate_limits(er, g.per_engine[f.info.name], [](std::string_view) { return false; });
+      read_known_failures(er, g.known_failures[f.info.name]);
     }
   }
 }
