@@ -65,7 +65,10 @@ struct CommonOptions {
 
 void add_common(CLI::App* cmd, CommonOptions& o) {
   cmd->add_option("PATH", o.paths, "scenario files (*.toml) or folders of them (searched recursively)")->required();
-  cmd->add_option("--engines", o.engines, "engines to run, comma-separated (default: all)")->delimiter(',');
+  // One value per --engines (split at commas), so `--engines core FILE` leaves FILE to PATH.
+  cmd->add_option("--engines", o.engines, "engines to run, comma-separated (default: all)")
+      ->delimiter(',')
+      ->allow_extra_args(false);
   cmd->add_option("--out", o.out, "output folder for results.json and series/")->capture_default_str();
   cmd->add_option("--dt", o.dt, "override every scenario's step, seconds (1/60 or 0.0166)");
   cmd->add_option("--duration", o.duration, "override every scenario's duration, seconds");
@@ -131,6 +134,13 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
   if (baseline_factor < 1.0) return bad_input("--baseline-factor must be >= 1");
   auto scenes = load_or_report(o.paths);
   if (!scenes) return kExitBadInput;
+  // --out is checked (and a staging folder made beside it) before anything runs.
+  std::optional<StagedOutputFolder> out;
+  try {
+    out.emplace(o.out);
+  } catch (const std::exception& e) {
+    return bad_input("--out: " + std::string(e.what()) + "; nothing was run");
+  }
 
   const Progress progress = terminal_progress(o.quiet);
   SuiteResult result = run_suite(*scenes, o.engines, options, gate,
@@ -151,22 +161,26 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
     print_suite_table(std::cout, result);
   }
   try {
-    write_results(o.out, result);
-    std::cout << "results: " << (std::filesystem::path(o.out) / "results.json").string() << '\n';
-    if (!junit.empty()) {
-      write_file_atomically(junit, junit_xml(result));
-      std::cout << "junit: " << junit << '\n';
-    }
+    // Everything goes into the staging folder, which then replaces --out whole.
+    write_results(out->staging(), result);
+    bool report_written = false;
     if (report) {
       try {
-        write_report(o.out, progress);
+        write_report(out->staging(), progress);
         end_progress(progress);
-        std::cout << "report: " << (std::filesystem::path(o.out) / "report.html").string() << '\n';
+        report_written = true;
       } catch (const plot::PlotError& e) {
         // The results and the page are written; only plots are missing. Not bad input.
         end_progress(progress);
         std::cerr << "physval: warning: the report's plots could not be drawn: " << e.what() << '\n';
       }
+    }
+    out->commit();
+    std::cout << "results: " << (std::filesystem::path(o.out) / "results.json").string() << '\n';
+    if (report_written) std::cout << "report: " << (std::filesystem::path(o.out) / "report.html").string() << '\n';
+    if (!junit.empty()) {
+      write_file_atomically(junit, junit_xml(result));
+      std::cout << "junit: " << junit << '\n';
     }
   } catch (const std::exception& e) {
     std::cerr << "physval: could not write the results: " << e.what() << '\n';
@@ -271,7 +285,9 @@ int main(int argc, char** argv) {
   sweep->add_option("SCENARIO", sweep_scenario, "one scenario file")->required();
   sweep->add_option("--dt", sweep_dts, "step sizes, comma-separated (default 1/30,1/60,1/120,1/240,1/480,1/960)")
       ->delimiter(',');
-  sweep->add_option("--engines", sweep_engines, "engines to sweep, comma-separated (default: all that can)")->delimiter(',');
+  sweep->add_option("--engines", sweep_engines, "engines to sweep, comma-separated (default: all that can)")
+      ->delimiter(',')
+      ->allow_extra_args(false);
   sweep->add_option("--out", sweep_out, "output folder: sweep.csv, sweep.json and the plots")->capture_default_str();
   sweep->add_option("--repetitions", sweep_repetitions, "timed repetitions per point (the median is reported)")
       ->capture_default_str();
@@ -301,7 +317,7 @@ int main(int argc, char** argv) {
       auto scenes = load_or_report(check_paths);
       if (!scenes) return kExitBadInput;
       for (const Scene& s : *scenes) {
-        std::cout << "ok  " << s.name << "  (" << s.source_file << ": " << s.bodies.size() << " bodies, "
+        std::cout << "ok  " << s.name << "  (" << s.source_file << ": " << s.bodies.size() << (s.bodies.size() == 1 ? " body, " : " bodies, ")
                   << s.walls.size() + s.boxes.size() + s.surfaces.size() << " barriers, " << s.steps() << " steps)\n";
       }
       std::cout << scenes->size() << " scenario" << (scenes->size() == 1 ? "" : "s") << " valid\n";
