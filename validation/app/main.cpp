@@ -364,6 +364,9 @@ int main(int argc, char** argv) {
       so.engines = sweep_engines;
       so.repetitions = sweep_repetitions;
       so.settings = !sweep_no_settings;
+      if (std::filesystem::is_directory(sweep_scenario)) {
+        return bad_input(sweep_scenario + ": is a folder; sweep takes one scenario file (*.toml)");
+      }
       ScenarioLoad load = load_scenario_file(sweep_scenario);
       for (const Diagnostic& d : load.errors) std::cerr << d.str() << '\n';
       if (!load.scene) return kExitBadInput;
@@ -375,6 +378,12 @@ int main(int argc, char** argv) {
       const Progress progress = terminal_progress(sweep_quiet);
       SweepResult result = run_sweep(*load.scene, so, progress);
       end_progress(progress);
+      if (result.points.empty()) {
+        // Nothing was measured (every engine left out): no table, and not a success.
+        for (const std::string& note : result.notes) std::cerr << "physval: " << note << '\n';
+        std::cerr << "physval: sweep measured nothing: no engine given can model " << load.scene->name << '\n';
+        return kExitFailed;
+      }
       print_sweep_table(std::cout, result);
       try {
         write_sweep(sweep_out, result);
