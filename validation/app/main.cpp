@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -99,6 +100,26 @@ Progress terminal_progress(bool quiet) {
   return [](const std::string& line) { std::cerr << "\r\033[K  " << line.substr(0, 90) << std::flush; };
 }
 
+// The suite's progress: "[n/N] scenario: engine" rewritten in place on a terminal; without
+// one (a CI log) one plain line per scenario as it starts, "[n/N] scenario".
+Progress suite_progress(bool quiet, std::size_t scenario_count) {
+  if (quiet) return {};
+  const bool terminal = ::isatty(2) != 0;
+  auto state = std::make_shared<std::pair<std::size_t, std::string>>(0, "");
+  return [terminal, scenario_count, state](const std::string& line) {
+    const std::string scenario = line.substr(0, line.find(':'));
+    if (scenario != state->second) {
+      state->second = scenario;
+      ++state->first;
+      if (!terminal) std::cerr << '[' << state->first << '/' << scenario_count << "] " << scenario << '\n' << std::flush;
+    }
+    if (terminal) {
+      std::cerr << "\r\033[K  [" << state->first << '/' << scenario_count << "] running " << line.substr(0, 80)
+                << std::flush;
+    }
+  };
+}
+
 void end_progress(const Progress& progress) {
   if (progress) std::cerr << "\r\033[K" << std::flush;
 }
@@ -143,8 +164,7 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
   }
 
   const Progress progress = terminal_progress(o.quiet);
-  SuiteResult result = run_suite(*scenes, o.engines, options, gate,
-                                 progress ? Progress([&](const std::string& l) { progress("running " + l); }) : Progress{});
+  SuiteResult result = run_suite(*scenes, o.engines, options, gate, suite_progress(o.quiet, scenes->size()));
   end_progress(progress);
   if (!baseline_path.empty()) {
     const int matched = apply_baseline(result, baseline, baseline_factor);

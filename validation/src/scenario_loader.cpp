@@ -154,8 +154,8 @@ class TableReader {
     } else if (const auto* str = n.as_string(); str != nullptr && parse_fraction(str->get())) {
       v = *parse_fraction(str->get());   // a fraction in quotes: dt = "1/120"
     } else if (n.is_string()) {
-      ctx_.error(n.source(), kp, "expected a number or a fraction in quotes such as \"1/120\", got \"" +
-                                     shown(n.as_string()->get()) + "\"");
+      ctx_.error(n.source(), kp, "expected a number, got a string \"" + shown(n.as_string()->get()) +
+                                     "\" (a fraction is written in quotes: \"1/120\")");
       return std::nullopt;
     } else {
       ctx_.error(n.source(), kp, std::string("expected a number, got ") + type_name(n));

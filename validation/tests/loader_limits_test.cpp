@@ -66,7 +66,8 @@ TEST(LoaderFractions, ABadFractionSaysHowToWriteOne) {
     const ScenarioLoad load =
         parse_scenario("name = \"f\"\nduration = 1.0\ndt = \"" + std::string(bad) + "\"\n" + body("a", 0.0), "f.toml");
     ASSERT_FALSE(load.scene) << bad;
-    EXPECT_NE(all_errors(load).find("f.toml:3:6: dt: expected a number or a fraction in quotes such as \"1/120\""),
+    EXPECT_NE(all_errors(load).find("f.toml:3:6: dt: expected a number, got a string \"" + std::string(bad) +
+                                      "\" (a fraction is written in quotes: \"1/120\")"),
               std::string::npos)
         << all_errors(load);
   }

@@ -227,4 +227,18 @@ TEST_F(Robust, CheckCountsOneBodyInTheSingular) {
   EXPECT_NE(r.output.find("1 body, 0 barriers, 50 steps"), std::string::npos) << r.output;
 }
 
+TEST_F(Robust, WithoutATerminalProgressIsOneLinePerScenario) {
+  write("one.toml", kShortFlight);
+  std::string second = kShortFlight;
+  second.replace(second.find("short_flight"), 12, "second_flight");
+  write("two.toml", second);
+  // popen: stderr is a pipe, as in a CI log.
+  const Result r = physval("run " + dir_.string() + " --out " + (dir_ / "out").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("[1/2] short_flight\n"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("[2/2] second_flight\n"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find('\r'), std::string::npos) << "no carriage returns in a log";
+  EXPECT_EQ(r.output.find("[1/2]"), r.output.rfind("[1/2]")) << "one line per scenario, not per engine";
+}
+
 }  // namespace
