@@ -31,9 +31,11 @@ constexpr const char* kPackageVersion = "2.4.1";
 std::vector<OptionSpec> box2d_options() {
   return {
       {"velocity_iterations", std::int64_t{8}, {},
-       "Velocity solver iterations per step (b2World::Step). 8 is Box2D's recommendation."},
+       "Velocity solver iterations per step (b2World::Step). 8 is Box2D's recommendation.",
+       OptionRange::between(1, 100000)},
       {"position_iterations", std::int64_t{3}, {},
-       "Position (overlap) solver iterations per step (b2World::Step). 3 is Box2D's recommendation."},
+       "Position (overlap) solver iterations per step (b2World::Step). 3 is Box2D's recommendation.",
+       OptionRange::between(0, 100000)},
       {"continuous", true, {},
        "Continuous collision (time of impact) of dynamic bodies against static ones "
        "(b2World::SetContinuousPhysics). Box2D's default."},
@@ -43,7 +45,8 @@ std::vector<OptionSpec> box2d_options() {
       {"warm_starting", true, {}, "Start each step's solver from the last step's impulses. Box2D's default."},
       {"restitution_threshold", 0.0, {},
        "Approach speed (m/s) below which a contact does not bounce. Box2D's own default is 1 m/s; "
-       "physval's 0 keeps an elastic scene elastic."},
+       "physval's 0 keeps an elastic scene elastic.",
+       OptionRange::at_least(0)},
       {"fixed_rotation", true, {},
        "Bodies do not spin (lecture model, collision step 6): b2BodyDef::fixedRotation. false: a "
        "circle has a uniform disc's inertia 0.5 m r^2 and friction can spin it."},

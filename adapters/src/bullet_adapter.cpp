@@ -45,7 +45,8 @@ std::vector<OptionSpec> bullet_options() {
   const btContactSolverInfo d;   // Bullet's own defaults, read from the library's headers
   return {
       {"solver_iterations", std::int64_t{d.m_numIterations}, {},
-       "Sequential-impulse solver iterations per step (btContactSolverInfo::m_numIterations). Bullet's default."},
+       "Sequential-impulse solver iterations per step (btContactSolverInfo::m_numIterations). Bullet's default.",
+       OptionRange::between(1, 100000)},
       {"split_impulse", true, {},
        "Correct overlaps with a split impulse that moves positions without changing velocities "
        "(m_splitImpulse). Bullet's default."},
@@ -54,12 +55,15 @@ std::vector<OptionSpec> bullet_options() {
        "velocity instead of the split impulse (m_splitImpulsePenetrationThreshold). Bullet's -0.04 makes "
        "an elastic gas gain energy (engines.md); physval's 1e30 splits every overlap."},
       {"erp", static_cast<double>(d.m_erp), {},
-       "Error reduction of overlaps corrected through the velocity (m_erp). Bullet's default."},
+       "Error reduction of overlaps corrected through the velocity (m_erp). Bullet's default.",
+       OptionRange::between(0, 1)},
       {"erp2", static_cast<double>(d.m_erp2), {},
-       "Error reduction of overlaps corrected by the split impulse (m_erp2). Bullet's default."},
+       "Error reduction of overlaps corrected by the split impulse (m_erp2). Bullet's default.",
+       OptionRange::between(0, 1)},
       {"warm_starting", true, {}, "Start each step's solver from the last step's impulses (SOLVER_USE_WARMSTARTING)."},
       {"warm_starting_factor", static_cast<double>(d.m_warmstartingFactor), {},
-       "Fraction of the last step's impulse the solver starts from (m_warmstartingFactor). Bullet's default."},
+       "Fraction of the last step's impulse the solver starts from (m_warmstartingFactor). Bullet's default.",
+       OptionRange::between(0, 1)},
       {"ccd", false, {},
        "Continuous collision: a sphere moving further than its radius in a step is swept "
        "(setCcdMotionThreshold = setCcdSweptSphereRadius = radius); needs contact_processing_threshold > 0, "
@@ -67,16 +71,20 @@ std::vector<OptionSpec> bullet_options() {
        "(engines.md: 69%; here a 10 m drop's apex fell to 9.15 m)."},
       {"restitution_threshold", 0.0, {},
        "Approach speed (m/s) below which a contact does not bounce (m_restitutionVelocityThreshold). "
-       "Bullet's own default is 0.2 m/s; physval's 0 keeps an elastic scene elastic."},
+       "Bullet's own default is 0.2 m/s; physval's 0 keeps an elastic scene elastic.",
+       OptionRange::at_least(0)},
       {"wall_half_thickness", 0.0, {},
        "Walls are boxes this thick on each side of the segment, with that margin as rounded ends (m). "
-       "0: the exact segment a circle touches at its radius."},
+       "0: the exact segment a circle touches at its radius.",
+       OptionRange::at_least(0)},
       {"box_margin", 0.0, {},
        "Collision margin of static boxes (m): corners rounded by it, faces where the scene puts them. "
-       "Bullet's own 0.04; 0 gives the scene's sharp box."},
+       "Bullet's own 0.04; 0 gives the scene's sharp box.",
+       OptionRange::at_least(0)},
       {"surface_depth", 0.1, {},
        "Each surface segment is a box this deep behind the surface (away from its normals), its front "
-       "face on the segment (m)."},
+       "face on the segment (m).",
+       OptionRange::above(0)},
       {"fixed_rotation", true, {},
        "Bodies do not spin (lecture model, collision step 6): angular factor 0. false: spin about z "
        "only, angular factor (0, 0, 1), a uniform disc's inertia 0.5 m r^2."},
@@ -84,7 +92,8 @@ std::vector<OptionSpec> bullet_options() {
        "Manifold points further apart than this (m) are not solved. Bullet's own (1e18) also solves points "
        "within its breaking threshold before the bodies touch, with a restitution that treats the gap as "
        "closing this step: an e = 0.5 bounce at 4 m/s left at 1.6 m/s instead of 2. 0: only touching "
-       "points are solved."},
+       "points are solved.",
+       OptionRange::at_least(0)},
       {"contact_begin", std::string("touch"), {"touch", "manifold"},
        "When a pair's contact begins: 'touch' = the first step after which the pair's manifold has a point "
        "at distance <= 0 or a normal impulse > 0; 'manifold' = its first manifold point at all "

@@ -4,8 +4,10 @@
 // touched within the preceding step length (dt). So a bounce after a flight of more
 // than one step is a new contact each time, while a ball settling, resting, sliding
 // along the floor or micro-bouncing under a pressing force is one contact, reported
-// at the impact that started it. Each body remembers its last partner and when they
-// touched (a resting body is touching its support at the end of every step).
+// at the impact that started it. Each touching pair is remembered with the time it last
+// touched (a resting body is touching its support at the end of every step), so a body
+// with several partners (a ball in a pile, in a V, on top of a pyramid) begins each
+// pair once.
 // Pairs whose collision-matrix response is "event" raise one event when they start
 // to overlap and pass through; they are remembered while they overlap.
 #include <algorithm>
@@ -19,21 +21,28 @@ std::uint32_t static_partner_key(const ObjectRef& owner) {
   return 0x80000000u | (static_cast<std::uint32_t>(owner.kind) << 28) | (owner.index & 0x0fffffffu);
 }
 
+std::uint64_t contact_key(std::uint32_t i, std::uint32_t partner) {
+  if (partner & 0x80000000u) return (static_cast<std::uint64_t>(i) << 32) | partner;
+  return (static_cast<std::uint64_t>(std::min(i, partner)) << 32) | std::max(i, partner);
+}
+
+void touch_contact(World& w, std::uint32_t i, std::uint32_t partner, double t_abs) {
+  if (w.any_forces) w.last_touch[contact_key(i, partner)] = t_abs;
+}
+
+void forget_old_contacts(World& w, double t0, double dt) {
+  // A contact this step is at t >= t0 and continues a touch no older than dt before it.
+  std::erase_if(w.last_touch, [&](const auto& kv) { return kv.second < t0 - dt; });
+}
+
 void record_contact(World& w, std::uint32_t i, std::uint32_t partner_body, const Segment* seg, double t_abs,
                     double window) {
-  const std::uint32_t key_i = seg ? static_partner_key(seg->owner) : partner_body;
+  const std::uint32_t partner = seg ? static_partner_key(seg->owner) : partner_body;
   bool continuing = false;
-  if (!w.last_partner.empty()) {
-    auto recent = [&](std::uint32_t body, std::uint32_t key) {
-      return w.last_partner[body] == key && t_abs - w.last_touch[body] <= window;
-    };
-    continuing = recent(i, key_i) || (!seg && recent(partner_body, i));
-    w.last_partner[i] = key_i;
-    w.last_touch[i] = t_abs;
-    if (!seg) {
-      w.last_partner[partner_body] = i;
-      w.last_touch[partner_body] = t_abs;
-    }
+  if (w.any_forces) {
+    auto [it, fresh] = w.last_touch.try_emplace(contact_key(i, partner), t_abs);
+    continuing = !fresh && t_abs - it->second <= window;
+    it->second = t_abs;
   }
   if (continuing) return;
   ContactEvent e;

@@ -69,11 +69,14 @@ void CoreEngine::step(double dt) {
   ctx.t0 = w.time;
   ctx.dt = dt;
   ctx.event_cap = w.max_events_option > 0 ? w.max_events_option
-                                          : 1000 + 100 * static_cast<std::int64_t>(w.size());
+                                          : core_detail::default_event_cap(w.size());
   const bool exact = w.mode == CollisionMode::Exact;
 
   // 1. forces: accelerations at the start of the step
-  if (w.any_forces) core_detail::compute_accelerations(w, w.pos, w.vel, w.acc);
+  if (w.any_forces) {
+    core_detail::forget_old_contacts(w, ctx.t0, dt);
+    core_detail::compute_accelerations(w, w.pos, w.vel, w.acc);
+  }
   // 2. resting contacts: the support takes the normal force; friction along it
   if (w.any_forces && exact) core_detail::apply_supports(w, ctx);
   // 3. integrator: start-of-step kicks and each body's path over the step
@@ -136,12 +139,22 @@ std::vector<Setting> CoreEngine::settings() const {
   s.emplace_back("cell_size", w.cell_size > 0.0 ? option_value_to_string(w.cell_size) : "auto");
   s.emplace_back("max_events_per_step",
                  w.max_events_option > 0 ? std::to_string(w.max_events_option)
-                                         : std::to_string(1000 + 100 * static_cast<std::int64_t>(w.size())) + " (auto)");
+                                         : std::to_string(core_detail::default_event_cap(w.size())) + " (auto)");
   s.emplace_back("rest_speed", w.rest_speed_option > 0.0
                                    ? option_value_to_string(w.rest_speed_option)
                                    : "auto (" + option_value_to_string(w.rest_factor) + " |a_n| dt)");
   s.emplace_back("precision", "float64");
   return s;
+}
+
+std::string CoreEngine::broken_guarantee() const {
+  const World& w = *world_;
+  if (!w.stats.event_cap_hit) return {};
+  std::ostringstream os;
+  os << "core reached its event cap (" << w.stats.events << " events) in the step ending at t = " << w.time
+     << " s: the rest of the step was finished by the lecture pass, so impacts were no longer exact "
+        "and bodies may have passed through each other (raise [core] max_events_per_step)";
+  return os.str();
 }
 
 std::vector<std::string> CoreEngine::limits_hit() const {

@@ -15,6 +15,7 @@ enum class EventKind : std::uint8_t {
   Stop,       // a = body sliding on its support comes to rest (friction)
   Leave,      // a = body's support point leaves the end of its segment
   Expire,     // a = particle reaches its lifetime
+  Emit,       // a = body (a trail's parent) emits a particle, b = emitter
 };
 
 // 24 bytes: the version of b shares its word with the kind and the feature (versions

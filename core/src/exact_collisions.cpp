@@ -82,6 +82,7 @@ class EventLoop {
     if (!w_.emitters.empty()) {
       w_.scratch_events.clear();
       schedule_explosions(w_, ctx_, w_.scratch_events);
+      schedule_trail_emissions(w_, ctx_, w_.scratch_events);
       for (const Event& e : w_.scratch_events) push(e);
     }
 
@@ -131,7 +132,8 @@ class EventLoop {
       case EventKind::Stop:
       case EventKind::Leave: return w_.version[e.a] == e.va;
       case EventKind::Explode:
-      case EventKind::Expire: return true;
+      case EventKind::Expire:
+      case EventKind::Emit: return true;
     }
     return false;
   }
@@ -175,6 +177,11 @@ class EventLoop {
     w_.statics.query(box, w_.found_static);
     if (w_.found_static.empty()) return;
     const Vec2 p = w_.pos_at(i, t), v = w_.vel_at(i, t), a = w_.path_acc(i);
+    // A body on a face moves along it (support_path removed its normal velocity and
+    // acceleration): that face is a constraint, not an impact to find. Testing it
+    // anyway met round-off (a normal velocity or acceleration of ~1e-16 read as
+    // "pressed together") and reported an impact at once, again and again.
+    const std::uint32_t own_face = w_.supported(i) && !w_.on_body(i) ? w_.support[i] : kNone;
     for (std::uint32_t k : w_.found_static) {
       const Segment& seg = w_.statics.segments[k];
       if (w_.any_rules) {
@@ -184,7 +191,7 @@ class EventLoop {
       }
       const toi::SegmentHit hit =
           toi::circle_segment(p, v, a, w_.radius[i], seg.from, seg.to, T_ - t, w_.length_scale);
-      if (hit.s == toi::kNever) continue;
+      if (hit.s == toi::kNever || (k == own_face && !hit.cap)) continue;
       push(Event::make(t + hit.s, i, k, w_.version[i], 0, EventKind::Static, hit.cap ? 1 : 0));
     }
   }
@@ -305,6 +312,9 @@ class EventLoop {
         w_.advance(e.a, e.time);
         explode_parent(w_, e.b, t_abs);
         free_dependents(e.a, e.time);
+        break;
+      case EventKind::Emit:   // reads the parent's path; its state is not touched
+        record_emission(w_, e.b, w_.pos_at(e.a, e.time), w_.vel_at(e.a, e.time), t_abs);
         break;
     }
   }

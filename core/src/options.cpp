@@ -1,5 +1,6 @@
 #include "physval/core/options.hpp"
 
+#include <cmath>
 #include <sstream>
 #include <string>
 
@@ -56,6 +57,15 @@ std::string option_value_to_string(const OptionValue& v) {
     std::string operator()(const std::string& s) const { return s; }
   };
   return std::visit(Visitor{}, v);
+}
+
+std::string OptionRange::describe() const {
+  auto num = [](double v) { return option_value_to_string(OptionValue{v}); };
+  const bool has_lo = std::isfinite(lo), has_hi = std::isfinite(hi);
+  if (has_lo && has_hi) return "in [" + num(lo) + ", " + num(hi) + "]";
+  if (has_lo) return (lo_open ? "> " : ">= ") + num(lo);
+  if (has_hi) return "<= " + num(hi);
+  return "any number";
 }
 
 const char* option_type_name(const OptionValue& v) {

@@ -6,9 +6,13 @@
 //            event of the step) and `count` particles start from its position and
 //            velocity then; they are created at the end of that step, placed where
 //            their ballistic paths have taken them.
-//   trail:   while the parent lives, one particle every 1/rate s (first at 1/rate),
-//            created at the end of the step at the parent's position, aged from its
-//            emission time.
+//   trail:   while the parent lives, one particle every 1/rate s (first at 1/rate).
+//            Exact mode: each emission is an event of the step, which reads the
+//            parent's position and velocity at that time; the particle is created at
+//            the end of the step where its ballistic path from there has taken it,
+//            aged from its emission time (like an explosion). Lecture mode (no events,
+//            and a step the event cap cut short): emissions due in the step leave at
+//            its end from the parent's end-of-step state, born then.
 // Randomness: std::mt19937_64 seeded by the emitter, mapped to [0, 1) with 53 bits and
 // disc points by rejection, so runs are bit-identical on every platform.
 // A particle never collides with its own parent, nor points with points.
@@ -78,6 +82,23 @@ void explode_parent(World& w, std::uint32_t emitter, double t_abs) {
   kill_body(w, e.parent);
 }
 
+void schedule_trail_emissions(World& w, const StepContext& ctx, std::vector<Event>& out) {
+  for (std::size_t k = 0; k < w.emitters.size(); ++k) {
+    const EmitterState& e = w.emitters[k];
+    if (e.def.mode != EmitterMode::Trail || !(e.def.rate > 0.0) || !w.alive(e.parent)) continue;
+    const double period = 1.0 / e.def.rate;
+    for (std::uint32_t n = e.serial + 1;; ++n) {
+      const double at = static_cast<double>(n) * period - ctx.t0;
+      if (at > ctx.dt) break;
+      out.push_back(Event::make(std::max(at, 0.0), e.parent, static_cast<std::uint32_t>(k), 0, 0, EventKind::Emit));
+    }
+  }
+}
+
+void record_emission(World& w, std::uint32_t emitter, Vec2 position, Vec2 velocity, double t_abs) {
+  w.emitters[emitter].emitted.push_back({position, velocity, t_abs});
+}
+
 void finish_particles(World& w, const StepContext& ctx) {
   const double t_end = ctx.t0 + ctx.dt;
   for (std::size_t k = 0; k < w.emitters.size(); ++k) {
@@ -97,9 +118,17 @@ void finish_particles(World& w, const StepContext& ctx) {
     } else {
       if (!(e.def.rate > 0.0)) continue;
       const double period = 1.0 / e.def.rate;
+      const Vec2 g = e.def.gravity ? w.gravity : Vec2{};
+      for (const EmitterState::Emission& em : e.emitted) {   // exact mode, in time order
+        const double s = t_end - em.time;
+        const Vec2 v0 = em.velocity + in_disc(e.rng, e.def.speed);
+        spawn(w, e, id, em.position + s * v0 + (0.5 * s * s) * g, v0 + s * g, em.time);
+      }
+      e.emitted.clear();
+      e.next_emit = static_cast<double>(e.serial + 1) * period;   // no drift from summing
       while (w.alive(e.parent) && e.next_emit <= t_end) {
-        spawn(w, e, id, w.pos[e.parent], w.vel[e.parent] + in_disc(e.rng, e.def.speed), e.next_emit);
-        e.next_emit = static_cast<double>(e.serial + 1) * period;   // no drift from summing
+        spawn(w, e, id, w.pos[e.parent], w.vel[e.parent] + in_disc(e.rng, e.def.speed), t_end);
+        e.next_emit = static_cast<double>(e.serial + 1) * period;
       }
     }
   }

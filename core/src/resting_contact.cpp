@@ -169,7 +169,7 @@ void apply_supports(World& w, const StepContext& ctx) {
     }
     support_path(w, i);
     // Still touching at the end of this step: one continuing contact.
-    if (!w.last_touch.empty()) w.last_touch[i] = ctx.t0;
+    touch_contact(w, i, static_partner_key(s.owner), ctx.t0);
   }
   // Bodies at rest on bodies: valid while the supporter is stuck, they still touch, and
   // they are still held. A stack settles from the bottom up, one level per pass.
@@ -189,7 +189,7 @@ void apply_supports(World& w, const StepContext& ctx) {
       if (ok) {
         w.support_n[i] = nrm;
         support_path(w, i);
-        if (!w.last_touch.empty()) w.last_touch[i] = ctx.t0;
+        touch_contact(w, i, j, ctx.t0);
       } else {
         release_support(w, i);
         changed = true;

@@ -2,12 +2,22 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace physval {
 
 int Scene::steps() const {
   const double n = std::ceil(duration / dt - 1e-9);
+  if (!(n <= static_cast<double>(kMaxSteps))) return kMaxSteps + 1;   // also NaN: never wraps
   return n < 1.0 ? 1 : static_cast<int>(n);
+}
+
+std::string scene_steps_error(const Scene& s) {
+  if (s.steps() <= Scene::kMaxSteps) return {};
+  char text[200];
+  std::snprintf(text, sizeof text, "duration / dt = %.6g / %.6g = %.4g steps, more than physval runs (%d); "
+                "shorten the duration or enlarge dt", s.duration, s.dt, s.duration / s.dt, Scene::kMaxSteps);
+  return text;
 }
 
 double Scene::last_step() const {

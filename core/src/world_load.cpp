@@ -35,14 +35,18 @@ std::vector<OptionSpec> core_option_specs() {
                "broad phase; all give the same pairs. auto: all_pairs below 64 bodies, grid for "
                "similar sizes, multigrid for a moderate spread of sizes, sort_and_sweep beyond"});
   s.push_back({"cell_size", 0.0, {},
-               "grid cell edge in m (grid: a lower bound; multigrid: the edge); 0 picks it from the bodies"});
+               "grid cell edge in m (grid: a lower bound; multigrid: the edge); 0 picks it from the bodies",
+       OptionRange::at_least(0)});
   s.push_back({"max_events_per_step", std::int64_t{0}, {},
                "exact mode: events one step may process; at the cap the rest of the step is finished "
-               "by the lecture pass and the run's limits record it. 0: 1000 + 100 per body"});
+                "by the lecture pass, impacts are no longer exact and the run stops as diverged. "
+                "0: 1,000,000 + 100 per body",
+        OptionRange::between(0, 1e9)});
   s.push_back({"rest_speed", 0.0, {},
                "m/s: an impact against a surface the body is pressed into, leaving slower than this, "
                "settles into resting contact. 0: |a_n| dt / 16 (velocity_verlet, rk4) or 1.5 |a_n| dt "
-               "(Euler integrators)"});
+               "(Euler integrators)",
+       OptionRange::at_least(0)});
   return s;
 }
 
@@ -186,7 +190,7 @@ void load_world(World& w, const Scene& scene) {
   if (w.newtonian) w.mass.reserve(cap);
   if (any_thrust) w.angle.reserve(cap);
   if (any_drag || any_thrust) w.fparams.reserve(cap);
-  if (w.any_forces) reserve_all(w.acc, w.apath, w.support, w.support_n, w.dep_head, w.dep_next, w.last_partner, w.last_touch);
+  if (w.any_forces) reserve_all(w.acc, w.apath, w.support, w.support_n, w.dep_head, w.dep_next);
   if (w.varying_forces) w.vcorr.reserve(cap);
 
   double extent = 0.0;
@@ -314,7 +318,7 @@ std::size_t World::memory_bytes() const {
   n += bytes_of(flags) + bytes_of(group) + bytes_of(material) + bytes_of(mass) + bytes_of(angle);
   n += bytes_of(acc) + bytes_of(apath) + bytes_of(vcorr) + bytes_of(fparams) + bytes_of(support);
   n += bytes_of(dep_head) + bytes_of(dep_next) + bytes_of(released);
-  n += bytes_of(support_n) + bytes_of(last_partner) + bytes_of(last_touch) + bytes_of(name_end);
+  n += bytes_of(support_n) + last_touch.size() * (sizeof(std::uint64_t) + sizeof(double) + 2 * sizeof(void*)) + bytes_of(name_end);
   n += name_chars.capacity() + 1;
   n += bytes_of(birth) + bytes_of(lifetime) + bytes_of(parent) + bytes_of(emitters);
   n += statics.memory_bytes() + bytes_of(material_table) + bytes_of(responses) + bytes_of(materials);

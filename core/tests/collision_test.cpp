@@ -138,3 +138,111 @@ TEST(CoreCollision, EventCapFinishesWithLecturePass) {
 }
 
 }  // namespace physval::test
+
+namespace physval::test {
+
+// Galperin's billiard: a light ball between a wall and a ball M/m = 100^k heavier bounces
+// exactly as many times as pi's first k+1 digits (e = 1). At 1e8 that is 31,415 impacts,
+// thousands of them inside single steps near the turning point.
+TEST(CoreCollision, PiBilliardMassRatio1e8FinishesExactlyUnderTheDefaultCap) {
+  const double M = 1e8;
+  Sim sim(scene_of({circle("light", {1.0, 0.0}, {}, 0.1, 1.0), circle("heavy", {2.0, 0.0}, {-1.0, 0.0}, 0.1, M)},
+                   {wall("wall", {0.0, -1.0}, {0.0, 1.0})}));
+  std::int64_t impacts = 0, most_in_a_step = 0;
+  while (sim.engine.time() < 3.0 - 1e-12) {
+    sim.step(0.01);
+    ASSERT_EQ(sim.engine.broken_guarantee(), "") << "t = " << sim.engine.time();
+    impacts += sim.engine.last_step_stats().impacts;
+    most_in_a_step = std::max(most_in_a_step, sim.engine.last_step_stats().impacts);
+  }
+  EXPECT_EQ(impacts, 31415);
+  EXPECT_GT(most_in_a_step, 1000);     // the old default cap (1000 + 100 N) broke here
+  EXPECT_TRUE(sim.engine.limits_hit().empty());
+  // Energy (round-off over 31,415 impacts: 1.9e-12 relative measured) and the final
+  // order: the heavy ball leaves faster than the light one follows.
+  const BodyState l = sim.state("light"), h = sim.state("heavy");
+  EXPECT_NEAR((0.5 * l.velocity.x * l.velocity.x + 0.5 * M * h.velocity.x * h.velocity.x) / (0.5 * M), 1.0, 1e-11);
+  EXPECT_GT(h.velocity.x, 0.0);
+  EXPECT_LE(l.velocity.x, h.velocity.x);
+  EXPECT_LT(l.position.x, h.position.x);   // no pass-through
+}
+
+TEST(CoreCollision, EventCapReachedIsABrokenGuarantee) {
+  // The same billiard with a cap of 500 events: the step that reaches it says so, and a
+  // step that does not leaves broken_guarantee() empty again.
+  EngineOptions opt = options("velocity_verlet");
+  opt["max_events_per_step"] = std::int64_t{500};
+  Sim sim(scene_of({circle("light", {1.0, 0.0}, {}, 0.1, 1.0), circle("heavy", {2.0, 0.0}, {-1.0, 0.0}, 0.1, 1e8)},
+                   {wall("wall", {0.0, -1.0}, {0.0, 1.0})}),
+          opt);
+  sim.step(0.01);
+  EXPECT_EQ(sim.engine.broken_guarantee(), "");
+  bool broke = false;
+  while (!broke && sim.engine.time() < 3.0) {
+    sim.step(0.01);
+    broke = !sim.engine.broken_guarantee().empty();
+  }
+  ASSERT_TRUE(broke);
+  EXPECT_NE(sim.engine.broken_guarantee().find("event cap"), std::string::npos);
+  EXPECT_TRUE(sim.engine.last_step_stats().event_cap_hit);
+}
+
+}  // namespace physval::test
+
+namespace physval::test {
+
+TEST(CoreCollision, BodiesTouchingAtTheStart) {
+  // Touching and closing at t = 0: the impact is at t = 0 exactly. Touching and
+  // separating, or touching at rest: nothing happens, no contact.
+  {
+    Sim sim(scene_of({circle("a", {-0.5, 0.0}, {1.0, 0.0}), circle("b", {0.5, 0.0}, {-1.0, 0.0})}));
+    sim.run_until(1.0, 0.01);
+    ASSERT_EQ(sim.contacts.size(), 1u);
+    EXPECT_EQ(sim.contacts[0].time, 0.0);
+    EXPECT_NEAR(sim.state("a").velocity.x, -1.0, 1e-15);
+    EXPECT_NEAR(sim.state("b").velocity.x, 1.0, 1e-15);
+    EXPECT_NEAR(sim.state("a").position.x, -1.5, 1e-12);
+  }
+  {
+    Sim sim(scene_of({circle("a", {-0.5, 0.0}, {-1.0, 0.0}), circle("b", {0.5, 0.0}, {1.0, 0.0})}));
+    sim.run_until(1.0, 0.01);
+    EXPECT_TRUE(sim.contacts.empty());
+    EXPECT_EQ(sim.state("a").velocity.x, -1.0);
+    EXPECT_EQ(sim.state("b").velocity.x, 1.0);
+  }
+  {
+    Sim sim(scene_of({circle("a", {-0.5, 0.0}), circle("b", {0.5, 0.0}), circle("c", {1.5, 0.0})}));
+    sim.run_until(1.0, 0.01);
+    EXPECT_TRUE(sim.contacts.empty());
+    for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(length_squared(sim.state(k).velocity), 0.0);
+  }
+}
+
+}  // namespace physval::test
+
+namespace physval::test {
+
+TEST(CoreCollision, GalperinBilliardCountsAtEveryMassRatioUpTo1e10) {
+  // A light ball between a wall and a heavy one (e = 1) collides N times in all, N the
+  // largest n with n atan(sqrt(m / M)) < pi (Galperin): 314 at 1e4, 3,141 at 1e6,
+  // 99,345 at 1e9, 314,159 at 1e10. Every impact must be resolved, under the default
+  // event cap, whatever the step.
+  for (double M : {1e4, 1e6, 1e9, 1e10}) {
+    SCOPED_TRACE(M);
+    const long double theta = std::atan(std::sqrt(1.0L / static_cast<long double>(M)));
+    const auto expected = static_cast<std::int64_t>(std::ceil(std::acos(-1.0L) / theta)) - 1;
+    Sim sim(scene_of({circle("light", {1.0, 0.0}, {}, 0.1, 1.0), circle("heavy", {2.0, 0.0}, {-1.0, 0.0}, 0.1, M)},
+                     {wall("wall", {0.0, -1.0}, {0.0, 1.0})}));
+    // Long enough for the last, slow return of the light ball from the wall.
+    std::int64_t impacts = 0;
+    while (sim.engine.time() < 200.0 - 1e-9) {
+      sim.step(0.05);
+      ASSERT_EQ(sim.engine.broken_guarantee(), "");
+      impacts += sim.engine.last_step_stats().impacts;
+    }
+    EXPECT_EQ(impacts, expected);
+    EXPECT_LT(sim.state("light").position.x, sim.state("heavy").position.x);
+  }
+}
+
+}  // namespace physval::test

@@ -115,4 +115,72 @@ TEST(CoreFriction, ImpactFrictionNeverReversesTangentialVelocity) {
   }
 }
 
+TEST(CoreFriction, SlopeGridHoldsOrSlidesExactlyWithNoZeroTimeImpacts) {
+  // A circle released touching an incline, over a grid of angles and (mu_s, mu_k): it
+  // holds where tan(angle) <= mu_s, else slides with a = g (sin - mu_k cos); after 2 s it
+  // is on the line to round-off and where the closed form says, and no step has any
+  // event. Before the body's own face stopped being an impact candidate, 12 of these
+  // 110 cases spun on zero-time impacts every step (a ~1e-16 normal acceleration read
+  // as "pressed together") and hit the event cap.
+  const double g = 9.8, r = 0.5;
+  int cases = 0;
+  for (int deg = 10; deg <= 60; deg += 5) {
+    for (double mu_s : {0.1, 0.2, 0.3, 0.5, 0.8}) {
+      for (double ratio : {0.5, 1.0}) {
+        const double mu_k = mu_s * ratio;
+        SCOPED_TRACE(std::to_string(deg) + " deg, mu_s " + std::to_string(mu_s) + ", mu_k " + std::to_string(mu_k));
+        const double th = deg * std::acos(-1.0) / 180.0;
+        const Vec2 d{std::cos(th), -std::sin(th)}, n{std::sin(th), std::cos(th)};
+        BodyDef b = circle("block", r * n, {}, r, 1.0, 0.0);
+        b.friction = mu_k;
+        b.static_friction = mu_s;
+        EngineOptions opt = options("velocity_verlet");
+        opt["max_events_per_step"] = std::int64_t{2000};
+        Sim sim(scene_of({b}, {wall("incline", -100.0 * d, 100.0 * d, 0.0, mu_k, mu_s)}, {0.0, -g}), opt);
+        std::int64_t events = 0;
+        for (int k = 0; k < 120; ++k) {
+          sim.step(1.0 / 60.0);
+          events += sim.engine.last_step_stats().events;
+          ASSERT_EQ(sim.engine.broken_guarantee(), "");
+        }
+        const double a = std::tan(th) > mu_s ? g * (std::sin(th) - mu_k * std::cos(th)) : 0.0;
+        const BodyState st = sim.state("block");
+        EXPECT_EQ(events, 0);
+        EXPECT_NEAR(dot(st.position, n) - r, 0.0, 1e-12);
+        EXPECT_NEAR(dot(st.position, d), 0.5 * a * 4.0, 1e-9);
+        EXPECT_NEAR(dot(st.velocity, d), a * 2.0, 1e-9);
+        ++cases;
+      }
+    }
+  }
+  EXPECT_EQ(cases, 110);
+}
+
+}  // namespace physval::test
+
+namespace physval::test {
+
+TEST(CoreFriction, LiftsOffAConvexKinkAndLandsOnTime) {
+  // Frictionless: a small circle slides 1 m down a 20 degree slope to a kink where a 50
+  // degree slope begins. Leaving the first face is an exact event (at sqrt(2 s / a)), and
+  // then it flies: it needs v^2 / r >> g cos to follow the corner, so it leaves along the
+  // first slope and lands on the second where its gap, r (cos 30 - 1) + v t sin 30 -
+  // g cos 50 t^2 / 2, comes back to 0.
+  const double g = 9.8, r = 0.01, s = 1.0, pi = std::acos(-1.0);
+  const double t1 = 20.0 * pi / 180.0, t2 = 50.0 * pi / 180.0;
+  const Vec2 d1{std::cos(t1), -std::sin(t1)}, n1{std::sin(t1), std::cos(t1)};
+  const Vec2 d2{std::cos(t2), -std::sin(t2)};
+  Sim sim(scene_of({circle("ball", -s * d1 + r * n1, {}, r, 1.0, 0.0)},
+                   {wall("upper", -5.0 * d1, {0.0, 0.0}, 0.0), wall("lower", {0.0, 0.0}, 20.0 * d2, 0.0)}, {0.0, -g}));
+  const double a = g * std::sin(t1);
+  const double t_leave = std::sqrt(2.0 * s / a), v = a * t_leave;
+  const double A = -0.5 * g * std::cos(t2), B = v * std::sin(pi / 6.0), C = r * (std::cos(pi / 6.0) - 1.0);
+  const double t_fly = (-B - std::sqrt(B * B - 4.0 * A * C)) / (2.0 * A);
+  sim.run_until(t_leave + t_fly + 0.5, 1.0 / 60.0);
+  double landing = -1.0;
+  for (const ContactEvent& c : sim.contacts)
+    if (c.b.kind != ObjectRef::Kind::Body && c.b.index == 1u && landing < 0.0) landing = c.time;
+  EXPECT_NEAR(landing, t_leave + t_fly, 1e-9);
+}
+
 }  // namespace physval::test

@@ -78,6 +78,37 @@ TEST(CoreParticles, TrailRateAndLifetime) {
   EXPECT_EQ(alive_particles(sim), 6);
 }
 
+TEST(CoreParticles, TrailParticlesStartWhereAndWhenTheyAreEmitted) {
+  // The rocket falls under gravity; its trail leaves at 0.1, 0.2, ... s, inside steps of
+  // 1/16 s, without gravity. Each particle, traced back along its straight line to its
+  // birth time, is at the rocket's position then, with a velocity within `speed` of the
+  // rocket's then; its age is the time since. (They were once placed at the rocket's
+  // end-of-step position but aged from their emission time: up to |v| dt off.)
+  const double g = 9.8;
+  EmitterDef e;
+  e.name = "smoke";
+  e.mode = EmitterMode::Trail;
+  e.rate = 10.0;
+  e.lifetime = 5.0;
+  e.speed = 0.5;
+  e.gravity = false;
+  Sim sim(rocket_with(e, {0.0, -g}));
+  sim.run_until(1.0, 1.0 / 16.0);
+  sim.engine.read_states(sim.states);
+  ASSERT_EQ(sim.states.size(), 11u);
+  for (std::size_t i = 1; i < sim.states.size(); ++i) {
+    SCOPED_TRACE(i);
+    const double tk = 0.1 * static_cast<double>(i);
+    const double age = sim.engine.particle_age(i);
+    EXPECT_NEAR(age, 1.0 - tk, 1e-12);
+    const BodyState& st = sim.states[i];
+    const Vec2 back = st.position - age * st.velocity;
+    EXPECT_NEAR(back.x, 3.0 * tk, 1e-12);
+    EXPECT_NEAR(back.y, 10.0 + 4.0 * tk - 0.5 * g * tk * tk, 1e-12);
+    EXPECT_LE(length(st.velocity - Vec2{3.0, 4.0 - g * tk}), 0.5 + 1e-12);
+  }
+}
+
 TEST(CoreParticles, DestroyedOnCollision) {
   // An explosion above a floor under gravity: every particle dies on its first impact
   // (well before its lifetime), none goes through the floor.

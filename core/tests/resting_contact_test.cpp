@@ -120,3 +120,34 @@ TEST(CoreResting, RollsOffTheEndAndFalls) {
 }
 
 }  // namespace physval::test
+
+namespace physval::test {
+
+TEST(CoreResting, TallStacksHoldExactly) {
+  // Columns of 10 and 50 touching circles on a floor, e = 0, 0.5, 1: after 2 s each is
+  // exactly where it started, one contact begins per touching pair, and no step comes
+  // near the event cap (at most one event per body and step).
+  for (int n : {10, 50}) {
+    for (double e : {0.0, 0.5, 1.0}) {
+      SCOPED_TRACE(std::to_string(n) + " bodies, e=" + std::to_string(e));
+      std::vector<BodyDef> b;
+      for (int k = 0; k < n; ++k) b.push_back(circle("b" + std::to_string(k), {0.0, 0.5 + k}, {}, 0.5, 1.0, e));
+      Sim sim(scene_of(b, {wall("floor", {-10.0, 0.0}, {10.0, 0.0}, e)}, {0.0, -9.8}));
+      std::int64_t worst = 0;
+      for (int k = 0; k < 120; ++k) {
+        sim.step(1.0 / 60.0);
+        worst = std::max(worst, sim.engine.last_step_stats().events);
+        ASSERT_EQ(sim.engine.broken_guarantee(), "");
+      }
+      EXPECT_LE(worst, n);
+      EXPECT_EQ(sim.contacts.size(), static_cast<std::size_t>(n));
+      for (int k = 0; k < n; ++k) {
+        const BodyState st = sim.state(static_cast<std::size_t>(k));
+        EXPECT_EQ(st.position.x, 0.0);
+        EXPECT_EQ(st.position.y, 0.5 + k);
+      }
+    }
+  }
+}
+
+}  // namespace physval::test

@@ -138,7 +138,7 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
   for (const std::string& e : o.engines) {
     if (find_engine(e) == nullptr) return bad_input("--engines: no engine named \"" + e + "\" (see `physval engines`)");
   }
-  if (o.timeout < 0.0) return bad_input("--timeout must be >= 0");
+  if (!(o.timeout >= 0.0)) return bad_input("--timeout must be a number >= 0");   // also NaN
   options.isolate = !o.no_isolate;
   options.timeout_seconds = o.timeout;
   nlohmann::json baseline;
@@ -152,9 +152,16 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
     }
     if (!baseline.contains("runs")) return bad_input(baseline_path + ": not a results.json (no \"runs\")");
   }
-  if (baseline_factor < 1.0) return bad_input("--baseline-factor must be >= 1");
+  if (!(baseline_factor >= 1.0) || !std::isfinite(baseline_factor)) {
+    return bad_input("--baseline-factor must be a finite number >= 1");   // NaN too
+  }
   auto scenes = load_or_report(o.paths);
   if (!scenes) return kExitBadInput;
+  for (const Scene& s : *scenes) {
+    if (const std::string too_many = scene_steps_error(effective_scene(s, options)); !too_many.empty()) {
+      return bad_input(s.source_file + ": with --duration/--dt: " + too_many);
+    }
+  }
   // --out is checked (and a staging folder made beside it) before anything runs.
   std::optional<StagedOutputFolder> out;
   try {
@@ -170,6 +177,17 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
     const int matched = apply_baseline(result, baseline, baseline_factor);
     std::cout << "baseline: " << matched << " runs matched in " << baseline_path << " (regression factor "
               << baseline_factor << ")\n";
+    if (matched == 0) return bad_input(baseline_path + ": the baseline matches no run (scenario and engine): nothing compared");
+  }
+  if (gate) {
+    std::size_t checked = 0;
+    for (const ScenarioResult& sr : result.scenarios) {
+      for (const RunRecord& r : sr.runs) checked += r.status == RunStatus::Unsupported ? 0 : 1;
+    }
+    if (checked == 0) {
+      std::cerr << "physval: gate: no engine ran any scenario (all unsupported or filtered out): nothing was checked\n";
+      return 1;
+    }
   }
   if (o.quiet) {
     std::ostringstream sink;

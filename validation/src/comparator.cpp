@@ -41,6 +41,20 @@ SeriesDivergence series_divergence(const Series& run, const Series& ref, double 
                                    double energy_runaway, std::size_t scene_bodies) {
   SeriesDivergence d;
   const std::vector<long> pairs = align_samples(run, ref, tolerance);
+  // A body destroyed at a sample time is alive in one run's sample and gone from the
+  // other's when their clocks fall on either side of it: the totals then differ by the
+  // body's energy though the motion agrees. Such a pair of samples (the alive sets differ,
+  // and agree again at the next paired sample) is left out of the energy and momentum
+  // comparison; a destruction that really differs still differs at the next sample.
+  auto same_alive = [&](std::size_t k) {
+    const std::vector<BodyState>& sa = run.states[k];
+    const std::vector<BodyState>& sb = ref.states[static_cast<std::size_t>(pairs[k])];
+    if (sa.size() != sb.size()) return false;
+    for (std::size_t i = 0; i < sa.size(); ++i) {
+      if (sa[i].alive != sb[i].alive) return false;
+    }
+    return true;
+  };
   double pmax = 0.0, psum = 0.0, emax = 0.0, esum = 0.0, mmax = 0.0, msum = 0.0;
   std::size_t pn = 0, n = 0;
   for (std::size_t k = 0; k < pairs.size(); ++k) {
@@ -55,6 +69,11 @@ SeriesDivergence series_divergence(const Series& run, const Series& ref, double 
       pmax = std::max(pmax, e);
       psum += e * e;
       ++pn;
+    }
+    if (k < run.states.size() && j < ref.states.size() && !same_alive(k)) {
+      std::size_t next = k + 1;
+      while (next < pairs.size() && pairs[next] < 0) ++next;
+      if (next < pairs.size() && next < run.states.size() && same_alive(next)) continue;
     }
     const double de = std::abs(run.totals[k].energy() - ref.totals[j].energy()) / scales.energy;
     const double dm = length(run.totals[k].momentum - ref.totals[j].momentum) / scales.momentum;
@@ -257,18 +276,48 @@ Reference make_reference(const Scene& scene, const RunOptions& options) {
   const SeriesDivergence d = series_divergence(fine_run.series, coarse_run.series, same_time(fine.dt, coarse.dt), scales,
                                                1e300, scene.bodies.size());
   ref.convergence_error = d.position_max.value_or(0.0);
-  // Size of the motion: the scene's extent or the farthest any body travels.
-  double travel = scales.length;
+  // Judged per body, so that no body can loosen another's limit (one body parked 1e7 m
+  // away made an unconverged gas "converged to 1.4 m"): body i may differ by
+  // 1e-6 x its own scale + 1e-9 m, its scale being the largest of its own travel, its
+  // radius and the lower median of all bodies' travel (which no single body moves).
+  const std::size_t nb = scene.bodies.size();
+  std::vector<double> travel(nb, 0.0);
   for (std::size_t k = 0; k < fine_run.series.states.size(); ++k) {
-    for (std::size_t i = 0; i < fine_run.series.states[k].size() && i < scene.bodies.size(); ++i) {
-      travel = std::max(travel, length(fine_run.series.states[k][i].position - scene.bodies[i].position));
+    for (std::size_t i = 0; i < fine_run.series.states[k].size() && i < nb; ++i) {
+      if (!fine_run.series.states[k][i].alive) continue;
+      travel[i] = std::max(travel[i], length(fine_run.series.states[k][i].position - scene.bodies[i].position));
     }
   }
-  const double tolerance = 1e-6 * travel + 1e-9;
-  ref.converged = ref.convergence_error <= tolerance;
+  double typical = 0.0;
+  if (nb > 0) {
+    std::vector<double> sorted = travel;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>((nb - 1) / 2), sorted.end());
+    typical = sorted[(nb - 1) / 2];
+  }
+  const std::vector<long> pairs = align_samples(fine_run.series, coarse_run.series, same_time(fine.dt, coarse.dt));
+  double worst_ratio = 0.0, worst_error = 0.0, worst_limit = 1e-9;
+  std::string worst_body;
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    if (pairs[k] < 0) continue;
+    const auto& sa = fine_run.series.states[k];
+    const auto& sb = coarse_run.series.states[static_cast<std::size_t>(pairs[k])];
+    for (std::size_t i = 0; i < std::min({sa.size(), sb.size(), nb}); ++i) {
+      if (!sa[i].alive || !sb[i].alive) continue;
+      const double limit = 1e-6 * std::max({travel[i], scene.bodies[i].radius, typical}) + 1e-9;
+      const double error = length(sa[i].position - sb[i].position);
+      if (error / limit > worst_ratio) {
+        worst_ratio = error / limit;
+        worst_error = error;
+        worst_limit = limit;
+        worst_body = scene.bodies[i].name;
+      }
+    }
+  }
+  ref.converged = worst_ratio <= 1.0 && std::isfinite(ref.convergence_error);
   if (!ref.converged) {
     ref.reason = "not converged: runs at dt/" + std::to_string(refine) + " and dt/" + std::to_string(refine / 2) +
-                 " differ by " + fmt(ref.convergence_error) + " m (limit " + fmt(tolerance) + " m)";
+                 " differ by " + fmt(worst_error) + " m for body " + worst_body + " (its limit " + fmt(worst_limit) +
+                 " m)";
   }
   ref.run = std::move(fine_run);
   return ref;
@@ -359,6 +408,17 @@ void compare_run(RunRecord& run, const Scene& scene, const Reference& reference,
   for (const auto& [metric, limit] : limits) {
     if (metric == "expectation_failures") continue;
     add_check(run, metric, limit, run.metrics[metric], enforce_gates);
+  }
+  // A gate that checks nothing is not a pass: a scenario without [gate] limits and
+  // without [expect] fails `physval gate` (the run's own status still shows in `run`).
+  if (enforce_gates && limits.empty() && scene.expect.empty()) {
+    Check c;
+    c.what = "nothing_checked (the scenario has no [gate] limit and no [expect])";
+    c.limit = 0.0;
+    c.value = std::nullopt;
+    c.pass = false;
+    c.enforced = true;
+    run.checks.push_back(c);
   }
 }
 

@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -121,6 +122,20 @@ int apply_baseline(SuiteResult& result, const nlohmann::json& baseline, double f
       auto it = old.find({r.scenario, r.engine});
       if (it == old.end() || !it->second->contains("metrics")) continue;
       ++matched;
+      // A baseline measured at another dt is not this run's: its numbers mean nothing here.
+      if (const nlohmann::json& old_run = *it->second; old_run.contains("dt") && old_run["dt"].is_number()) {
+        const double old_dt = old_run["dt"].get<double>();
+        if (!(std::abs(old_dt - r.dt) <= 1e-12 * std::max(old_dt, r.dt))) {
+          Check c;
+          c.what = "baseline.dt (the baseline ran at dt " + g(old_dt) + " s, this run at " + g(r.dt) + " s)";
+          c.limit = r.dt;
+          c.value = old_dt;
+          c.pass = false;
+          c.enforced = true;
+          r.checks.push_back(c);
+          continue;
+        }
+      }
       const nlohmann::json& om = (*it->second)["metrics"];
       for (const char* name : kErrorMetrics) {
         if (!om.contains(name) || !om[name].is_number()) continue;

@@ -583,13 +583,25 @@ void read_engine_options(Context& ctx, const toml::table& t, const EngineInfo& i
         break;
       case 1:
         if (const auto* i = n->as_integer()) {
-          out[spec.key] = static_cast<std::int64_t>(i->get());
+          const auto v = static_cast<std::int64_t>(i->get());
+          if (!spec.range.contains(static_cast<double>(v))) {
+            r.error_at(*n, spec.key, "must be " + spec.range.describe() + ", got " + std::to_string(v));
+            break;
+          }
+          out[spec.key] = v;
         } else {
           r.error_at(*n, spec.key, std::string("expected an integer, got ") + type_name(*n));
         }
         break;
       case 2:
-        if (auto v = r.to_number(*n, kp)) out[spec.key] = *v;
+        if (auto v = r.to_number(*n, kp)) {
+          if (!std::isfinite(*v) || !spec.range.contains(*v)) {
+            r.error_at(*n, spec.key, "must be a finite number " + spec.range.describe() + ", got " +
+                                         option_value_to_string(OptionValue{*v}));
+            break;
+          }
+          out[spec.key] = *v;
+        }
         break;
       default: {
         std::string s;
@@ -680,6 +692,40 @@ void check_references(Context& ctx, const toml::table& root, Scene& s) {
   }
 }
 
+// Bodies that overlap at t = 0 are an error unless the scene opts in with
+// allow_initial_overlap = true: engines resolve them each in their own way (the
+// reference reported ~500 missed contacts), so nothing afterwards compares. Sweep
+// over x (n log n): the first few overlapping pairs are reported, each at the later body.
+void check_initial_overlaps(Context& ctx, const toml::table& root, const Scene& s) {
+  std::vector<std::size_t> order(s.bodies.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  auto lo = [&](std::size_t i) { return s.bodies[i].position.x - s.bodies[i].radius; };
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return lo(a) < lo(b); });
+  const auto* array = root.get_as<toml::array>("bodies");
+  int reported = 0;
+  for (std::size_t k = 0; k < order.size() && reported < 5; ++k) {
+    const BodyDef& a = s.bodies[order[k]];
+    for (std::size_t m = k + 1; m < order.size() && reported < 5; ++m) {
+      const BodyDef& b = s.bodies[order[m]];
+      if (lo(order[m]) > a.position.x + a.radius) break;
+      const double reach = a.radius + b.radius;
+      const double depth = reach - length(b.position - a.position);
+      if (depth <= 1e-9 * reach + 1e-12) continue;
+      const std::size_t later = std::max(order[k], order[m]);
+      const toml::node* at = array != nullptr && later < array->size() ? array->get(later) : nullptr;
+      if (const auto* t = at != nullptr ? at->as_table() : nullptr; t != nullptr && t->get("position") != nullptr) {
+        at = t->get("position");
+      }
+      char text[160];
+      std::snprintf(text, sizeof text, "overlaps body \"%s\" by %.3g m at t = 0", (later == order[k] ? b : a).name.c_str(),
+                    depth);
+      ctx.error(at != nullptr ? at->source() : root.source(), indexed("bodies", later) + ".position",
+                std::string(text) + " (set allow_initial_overlap = true at the top level if you mean it)");
+      ++reported;
+    }
+  }
+}
+
 Scene read_scene(Context& ctx, const toml::table& root) {
   Scene s;
   s.source_file = ctx.file;
@@ -694,6 +740,12 @@ Scene read_scene(Context& ctx, const toml::table& root) {
   r.read_required("duration", s.duration, "> 0", [](double v) { return v > 0.0; });
   r.read("dt", s.dt, "> 0", [](double v) { return v > 0.0; });
   r.read("sample_interval", s.sample_interval, ">= 0", [](double v) { return v >= 0.0; });
+  if (s.duration > 0.0 && s.dt > 0.0) {
+    if (const std::string too_many = scene_steps_error(s); !too_many.empty()) {
+      const toml::node* at = root.get("dt") != nullptr ? root.get("dt") : root.get("duration");
+      if (at != nullptr) r.error_at(*at, root.get("dt") != nullptr ? "dt" : "duration", too_many);
+    }
+  }
   if (const toml::node* n = r.node("engines")) {
     const auto* a = n->as_array();
     if (a == nullptr) {
@@ -878,8 +930,11 @@ Scene read_scene(Context& ctx, const toml::table& root) {
                                             format_number(s.sample_interval));
     }
   }
+  bool allow_initial_overlap = false;
+  r.read("allow_initial_overlap", allow_initial_overlap);
   r.finish();
   check_references(ctx, root, s);
+  if (!allow_initial_overlap) check_initial_overlaps(ctx, root, s);
   return s;
 }
 

@@ -6,7 +6,7 @@
 //   collision            exact | lecture [exact]
 //   broadphase           auto | all_pairs | grid | multigrid | sort_and_sweep [auto]
 //   cell_size            float, m; 0 = picked from the bodies each step [0]
-//   max_events_per_step  integer; 0 = 1000 + 100 N [0]
+//   max_events_per_step  integer; 0 = 1,000,000 + 100 N [0]
 //   rest_speed           float, m/s; 0 = auto [0]
 // The README's scenario reference documents each one; core_engine.cpp holds the specs.
 #pragma once
@@ -51,6 +51,9 @@ class CoreEngine final : public Engine {
   const std::vector<ContactEvent>& contacts() const override;
   std::vector<Setting> settings() const override;
   std::vector<std::string> limits_hit() const override;
+  // Non-empty when the last step reached the event cap: its remaining impacts were not
+  // resolved exactly, so bodies may have passed through each other (the runner stops there).
+  std::string broken_guarantee() const override;
 
   // Particles: age in seconds (-1 for a body that is not a particle) and colour
   // intensity, 1 at birth falling linearly to 0 at the end of its life.

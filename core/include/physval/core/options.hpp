@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -13,11 +14,27 @@
 
 namespace physval {
 
+// The values a numeric option accepts: lo <= v <= hi, or lo < v when lo_open. The
+// loader checks every given integer and float against it (`physval check`, exit 2).
+struct OptionRange {
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  bool lo_open = false;
+
+  static OptionRange any() { return {}; }
+  static OptionRange at_least(double v) { return {v, std::numeric_limits<double>::infinity(), false}; }
+  static OptionRange above(double v) { return {v, std::numeric_limits<double>::infinity(), true}; }
+  static OptionRange between(double a, double b) { return {a, b, false}; }
+  bool contains(double v) const { return (lo_open ? v > lo : v >= lo) && v <= hi; }
+  std::string describe() const;   // ">= 1", "> 0", "in [0, 1]"
+};
+
 struct OptionSpec {
   std::string key;
   OptionValue default_value;           // its alternative is the option's type
   std::vector<std::string> choices;    // for string options: the allowed values
   std::string doc;
+  OptionRange range = OptionRange::any();   // numeric options: the values accepted
 };
 
 class OptionReader {

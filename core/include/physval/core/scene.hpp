@@ -232,7 +232,11 @@ struct Scene {
 
   // A run takes steps() steps of dt, the last one shortened so that it ends exactly
   // at `duration`: steps() = ceil(duration / dt) (a remainder under 1e-9 dt is round-off).
+  // Never wraps: a duration / dt beyond kMaxSteps (or NaN) saturates at kMaxSteps + 1,
+  // which still fits an int, and the loader and the --duration/--dt overrides refuse such
+  // a scene with exit 2 (scene_steps_error).
   int steps() const;
+  static constexpr int kMaxSteps = 1'000'000'000;
   double last_step() const;   // the length of the last step, in (0, dt]
   // Index of the body with this name, or -1.
   int body_index(const std::string& body_name) const;
@@ -254,6 +258,10 @@ struct MaterialView {
   double static_friction;
   double rolling_friction;
 };
+
+// Empty when the scene's step count is within Scene::kMaxSteps; else a message saying why not.
+std::string scene_steps_error(const Scene& s);
+
 MaterialView material_of(const BodyDef& b);
 MaterialView material_of(const std::string& name, const StaticMaterial& m);
 PairMaterial combine_materials(const Scene& scene, const MaterialView& a, const MaterialView& b);

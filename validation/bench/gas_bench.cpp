@@ -98,8 +98,13 @@ void register_all() {
 
 }  // namespace
 
+namespace physval::bench {
+void register_contact_benchmarks();   // contact_bench.cpp
+}
+
 int main(int argc, char** argv) {
   register_all();
+  physval::bench::register_contact_benchmarks();
   // Fixed step counts per N (see timed_steps), one repetition: the report is one run.
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
