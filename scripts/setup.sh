@@ -9,6 +9,7 @@ packages=(
   libgtest-dev libbenchmark-dev
   gnuplot-nox
   python3
+  clang-14 libclang-rt-14-dev
 )
 missing=()
 for p in "${packages[@]}"; do

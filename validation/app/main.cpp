@@ -7,6 +7,8 @@
 #include <fstream>
 #include <sstream>
 #include <iostream>
+#include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -72,7 +74,10 @@ struct CommonOptions {
 
 void add_common(CLI::App* cmd, CommonOptions& o) {
   cmd->add_option("PATH", o.paths, "scenario files (*.toml) or folders of them (searched recursively)")->required();
-  cmd->add_option("--engines", o.engines, "engines to run, comma-separated (default: all)")->delimiter(',');
+  // One value per --engines (split at commas), so `--engines core FILE` leaves FILE to PATH.
+  cmd->add_option("--engines", o.engines, "engines to run, comma-separated (default: all)")
+      ->delimiter(',')
+      ->allow_extra_args(false);
   cmd->add_option("--out", o.out, "output folder for results.json and series/")->capture_default_str();
   cmd->add_option("--dt", o.dt, "override every scenario's step, seconds (1/60 or 0.0166)");
   cmd->add_option("--duration", o.duration, "override every scenario's duration, seconds");
@@ -104,6 +109,26 @@ std::optional<std::vector<Scene>> load_or_report(const std::vector<std::string>&
 Progress terminal_progress(bool quiet) {
   if (quiet || ::isatty(2) == 0) return {};
   return [](const std::string& line) { std::cerr << "\r\033[K  " << line.substr(0, 90) << std::flush; };
+}
+
+// The suite's progress: "[n/N] scenario: engine" rewritten in place on a terminal; without
+// one (a CI log) one plain line per scenario as it starts, "[n/N] scenario".
+Progress suite_progress(bool quiet, std::size_t scenario_count) {
+  if (quiet) return {};
+  const bool terminal = ::isatty(2) != 0;
+  // Lines arrive as "scenario: engine", in any order under -j: a scenario counts when
+  // its first run starts.
+  auto seen = std::make_shared<std::set<std::string>>();
+  return [terminal, scenario_count, seen](const std::string& line) {
+    const std::string scenario = line.substr(0, line.find(':'));
+    if (seen->insert(scenario).second && !terminal) {
+      std::cerr << '[' << seen->size() << '/' << scenario_count << "] " << scenario << '\n' << std::flush;
+    }
+    if (terminal) {
+      std::cerr << "\r\033[K  [" << seen->size() << '/' << scenario_count << "] running " << line.substr(0, 80)
+                << std::flush;
+    }
+  };
 }
 
 void end_progress(const Progress& progress) {
@@ -167,12 +192,17 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
       return bad_input(s.source_file + ": with --duration/--dt: " + too_many);
     }
   }
+  // --out is checked (and a staging folder made beside it) before anything runs.
+  std::optional<StagedOutputFolder> out;
+  try {
+    out.emplace(o.out);
+  } catch (const std::exception& e) {
+    return bad_input("--out: " + std::string(e.what()) + "; nothing was run");
+  }
 
   const Progress progress = terminal_progress(o.quiet);
   const std::size_t jobs = o.jobs > 0 ? static_cast<std::size_t>(o.jobs) : default_jobs();
-  SuiteResult result = run_suite(*scenes, o.engines, options, gate,
-                                 progress ? Progress([&](const std::string& l) { progress("running " + l); }) : Progress{},
-                                 jobs);
+  SuiteResult result = run_suite(*scenes, o.engines, options, gate, suite_progress(o.quiet, scenes->size()), jobs);
   end_progress(progress);
   if (!baseline_path.empty()) {
     const int matched = apply_baseline(result, baseline, baseline_factor);
@@ -208,22 +238,26 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
     print_suite_table(std::cout, result);
   }
   try {
-    write_results(o.out, result);
-    std::cout << "results: " << (std::filesystem::path(o.out) / "results.json").string() << '\n';
-    if (!junit.empty()) {
-      write_file_atomically(junit, junit_xml(result));
-      std::cout << "junit: " << junit << '\n';
-    }
+    // Everything goes into the staging folder, which then replaces --out whole.
+    write_results(out->staging(), result);
+    bool report_written = false;
     if (report) {
       try {
-        write_report(o.out, progress);
+        write_report(out->staging(), progress);
         end_progress(progress);
-        std::cout << "report: " << (std::filesystem::path(o.out) / "report.html").string() << '\n';
+        report_written = true;
       } catch (const plot::PlotError& e) {
         // The results and the page are written; only plots are missing. Not bad input.
         end_progress(progress);
         std::cerr << "physval: warning: the report's plots could not be drawn: " << e.what() << '\n';
       }
+    }
+    out->commit();
+    std::cout << "results: " << (std::filesystem::path(o.out) / "results.json").string() << '\n';
+    if (report_written) std::cout << "report: " << (std::filesystem::path(o.out) / "report.html").string() << '\n';
+    if (!junit.empty()) {
+      write_file_atomically(junit, junit_xml(result));
+      std::cout << "junit: " << junit << '\n';
     }
   } catch (const std::exception& e) {
     std::cerr << "physval: could not write the results: " << e.what() << '\n';
@@ -332,7 +366,9 @@ int main(int argc, char** argv) {
   sweep->add_option("SCENARIO", sweep_scenario, "one scenario file")->required();
   sweep->add_option("--dt", sweep_dts, "step sizes, comma-separated (default 1/30,1/60,1/120,1/240,1/480,1/960)")
       ->delimiter(',');
-  sweep->add_option("--engines", sweep_engines, "engines to sweep, comma-separated (default: all that can)")->delimiter(',');
+  sweep->add_option("--engines", sweep_engines, "engines to sweep, comma-separated (default: all that can)")
+      ->delimiter(',')
+      ->allow_extra_args(false);
   sweep->add_option("--out", sweep_out, "output folder: sweep.csv, sweep.json and the plots")->capture_default_str();
   sweep->add_option("--repetitions", sweep_repetitions, "timed repetitions per point (the median is reported)")
       ->capture_default_str();
@@ -368,7 +404,7 @@ int main(int argc, char** argv) {
       auto scenes = load_or_report(check_paths);
       if (!scenes) return kExitBadInput;
       for (const Scene& s : *scenes) {
-        std::cout << "ok  " << s.name << "  (" << s.source_file << ": " << s.bodies.size() << " bodies, "
+        std::cout << "ok  " << s.name << "  (" << s.source_file << ": " << s.bodies.size() << (s.bodies.size() == 1 ? " body, " : " bodies, ")
                   << s.walls.size() + s.boxes.size() + s.surfaces.size() << " barriers, " << s.steps() << " steps)\n";
       }
       std::cout << scenes->size() << " scenario" << (scenes->size() == 1 ? "" : "s") << " valid\n";
@@ -423,6 +459,9 @@ int main(int argc, char** argv) {
       so.engines = sweep_engines;
       so.repetitions = sweep_repetitions;
       so.settings = !sweep_no_settings;
+      if (std::filesystem::is_directory(sweep_scenario)) {
+        return bad_input(sweep_scenario + ": is a folder; sweep takes one scenario file (*.toml)");
+      }
       ScenarioLoad load = load_scenario_file(sweep_scenario);
       for (const Diagnostic& d : load.errors) std::cerr << d.str() << '\n';
       if (!load.scene) return kExitBadInput;
@@ -434,6 +473,12 @@ int main(int argc, char** argv) {
       const Progress progress = terminal_progress(sweep_quiet);
       SweepResult result = run_sweep(*load.scene, so, progress);
       end_progress(progress);
+      if (result.points.empty()) {
+        // Nothing was measured (every engine left out): no table, and not a success.
+        for (const std::string& note : result.notes) std::cerr << "physval: " << note << '\n';
+        std::cerr << "physval: sweep measured nothing: no engine given can model " << load.scene->name << '\n';
+        return kExitFailed;
+      }
       print_sweep_table(std::cout, result);
       try {
         write_sweep(sweep_out, result);

@@ -3,6 +3,7 @@
 #include "physval/validation/comparator.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -290,6 +291,11 @@ Reference make_reference(const Scene& scene, const RunOptions& options) {
   };
   RunOptions ro = options;
   ro.max_sample_states = static_cast<std::size_t>(-1);
+  // One --timeout bounds the reference's two runs together, as it bounds one engine run.
+  if (ro.timeout_seconds > 0.0 && !ro.deadline) {
+    ro.deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                         std::chrono::duration<double>(ro.timeout_seconds));
+  }
   const Scene fine = variant(refine);
   const Scene coarse = variant(refine / 2);
   RunRecord fine_run = run_engine_isolated(fine, *engine, ro);

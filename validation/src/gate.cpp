@@ -2,10 +2,16 @@
 
 #include "markup_escape.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <ctime>
+#include <iomanip>
 #include <map>
 #include <sstream>
+#include <vector>
 
 namespace physval {
 
@@ -25,10 +31,37 @@ constexpr const char* kErrorMetrics[] = {
     "energy_drift", "linear_momentum_drift", "angular_momentum_drift", "energy_divergence",
     "linear_momentum_divergence", "position_divergence", "contact_time_error"};
 
+// JUnit's timestamp: ISO 8601 without a zone (the Jenkins/Surefire schema's xs:dateTime
+// pattern), in UTC.
+std::string junit_timestamp() {
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  std::ostringstream os;
+  os << std::put_time(&tm, "%Y-%m-%dT%H:%M:%S");
+  return os.str();
+}
+
+std::string junit_hostname() {
+  char host[256] = {};
+  if (::gethostname(host, sizeof host - 1) != 0 || host[0] == '\0') return "localhost";
+  return host;
+}
+
+// Every enforced check that failed, with its value and limit: "energy_drift = 0.3 > limit 1e-09".
+std::vector<std::string> failed_checks(const RunRecord& r) {
+  std::vector<std::string> out;
+  for (const Check& c : r.checks) {
+    if (c.pass || !c.enforced) continue;
+    out.push_back(c.what + " = " + (c.value ? g(*c.value) : std::string("not measured")) + " > limit " + g(c.limit));
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string junit_xml(const SuiteResult& result) {
-  int tests = 0, failures = 0, skipped = 0;
+  int tests = 0, failures = 0, errors = 0, skipped = 0;
   double total_time = 0.0;
   std::ostringstream cases;
   for (const ScenarioResult& sr : result.scenarios) {
@@ -40,17 +73,23 @@ std::string junit_xml(const SuiteResult& result) {
       if (r.status == RunStatus::Unsupported) {
         ++skipped;
         cases << "      <skipped message=\"" << xml_escape(r.reason) << "\"/>\n";
+      } else if (r.status == RunStatus::Error) {
+        // The run did not finish (crash, timeout, exception): a JUnit error, not a failure.
+        ++errors;
+        const bool timeout = r.reason.rfind("timed out", 0) == 0;
+        cases << "      <error message=\"" << xml_escape(r.reason) << "\" type=\"" << (timeout ? "timeout" : "crash")
+              << "\">" << xml_escape(r.reason) << "</error>\n";
       } else if (!r.passed()) {
         ++failures;
-        std::ostringstream detail;
-        if (r.status != RunStatus::Ok) detail << run_status_name(r.status) << ": " << r.reason << '\n';
-        for (const Check& c : r.checks) {
-          if (c.pass || !c.enforced) continue;
-          detail << c.what << " = " << (c.value ? g(*c.value) : std::string("not measured")) << " > limit " << g(c.limit)
-                 << '\n';
+        std::vector<std::string> parts;
+        if (r.status != RunStatus::Ok) parts.push_back(std::string(run_status_name(r.status)) + ": " + r.reason);
+        for (std::string& f : failed_checks(r)) parts.push_back(std::move(f));
+        std::string message, detail;
+        for (std::size_t i = 0; i < parts.size(); ++i) {
+          message += (i ? "; " : "") + parts[i];
+          detail += parts[i] + '\n';
         }
-        std::string first = detail.str().substr(0, detail.str().find('\n'));
-        cases << "      <failure message=\"" << xml_escape(first) << "\" type=\"physval\">" << xml_escape(detail.str())
+        cases << "      <failure message=\"" << xml_escape(message) << "\" type=\"physval\">" << xml_escape(detail)
               << "</failure>\n";
       }
       cases << "    </testcase>\n";
@@ -58,11 +97,13 @@ std::string junit_xml(const SuiteResult& result) {
   }
   std::ostringstream os;
   os << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-     << "<testsuites name=\"physval\" tests=\"" << tests << "\" failures=\"" << failures << "\" skipped=\"" << skipped
-     << "\" time=\"" << total_time << "\">\n"
-     << "  <testsuite name=\"physval\" tests=\"" << tests << "\" failures=\"" << failures << "\" errors=\"0\" skipped=\""
-     << skipped << "\" time=\"" << total_time << "\">\n"
-     << cases.str() << "  </testsuite>\n</testsuites>\n";
+     << "<testsuites name=\"physval\" tests=\"" << tests << "\" failures=\"" << failures << "\" errors=\"" << errors
+     << "\" skipped=\"" << skipped << "\" time=\"" << total_time << "\">\n"
+     << "  <testsuite name=\"physval\" tests=\"" << tests << "\" failures=\"" << failures << "\" errors=\"" << errors
+     << "\" skipped=\"" << skipped << "\" time=\"" << total_time << "\" timestamp=\"" << junit_timestamp()
+     << "\" hostname=\"" << xml_escape(junit_hostname()) << "\">\n"
+     << "    <properties/>\n"
+     << cases.str() << "    <system-out/>\n    <system-err/>\n  </testsuite>\n</testsuites>\n";
   return os.str();
 }
 

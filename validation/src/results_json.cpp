@@ -150,6 +150,65 @@ void write_file_atomically(const std::filesystem::path& path, const std::string&
   }
 }
 
+namespace {
+
+std::filesystem::path sibling(const std::filesystem::path& final_dir, const std::string& tag) {
+  std::string name = ".";
+  name.append(final_dir.filename().string()).append(".").append(tag).append(".").append(std::to_string(::getpid()));
+  return final_dir.parent_path() / name;
+}
+
+}  // namespace
+
+StagedOutputFolder::StagedOutputFolder(std::filesystem::path final_dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  final_ = fs::absolute(final_dir, ec).lexically_normal();
+  if (ec) throw std::runtime_error(final_dir.string() + ": " + ec.message());
+  if (!final_.has_filename()) final_ = final_.parent_path();   // "out/" -> "out"
+  const std::string shown = final_dir.string();
+  if (fs::exists(final_, ec)) {
+    if (!fs::is_directory(final_, ec)) throw std::runtime_error(shown + " exists and is not a folder");
+    if (!fs::is_empty(final_, ec) && !fs::exists(final_ / "results.json", ec)) {
+      throw std::runtime_error(shown + " is a folder with files but no results.json, so not an earlier physval output; "
+                               "physval replaces its output folder whole and will not replace this one (choose another --out)");
+    }
+  }
+  fs::create_directories(final_.parent_path(), ec);
+  if (ec) throw std::runtime_error("cannot create " + final_.parent_path().string() + ": " + ec.message());
+  staging_ = sibling(final_, "staging");
+  fs::remove_all(staging_, ec);
+  if (!fs::create_directory(staging_, ec) || ec) {
+    throw std::runtime_error("cannot write in " + final_.parent_path().string() + " (for " + shown +
+                             "): " + (ec ? ec.message() : std::string("could not create a folder")));
+  }
+}
+
+StagedOutputFolder::~StagedOutputFolder() {
+  if (committed_) return;
+  std::error_code ec;
+  std::filesystem::remove_all(staging_, ec);
+}
+
+void StagedOutputFolder::commit() {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path old = sibling(final_, "old");
+  const bool had_old = fs::exists(final_, ec);
+  if (had_old) {
+    fs::remove_all(old, ec);
+    fs::rename(final_, old, ec);
+    if (ec) throw std::runtime_error("cannot move the earlier " + final_.string() + " aside: " + ec.message());
+  }
+  fs::rename(staging_, final_, ec);
+  if (ec) {
+    if (had_old) fs::rename(old, final_, ec);
+    throw std::runtime_error("cannot move " + staging_.string() + " to " + final_.string() + ": " + ec.message());
+  }
+  committed_ = true;
+  if (had_old) fs::remove_all(old, ec);
+}
+
 void write_results(const std::filesystem::path& dir, const SuiteResult& result) {
   // Series first: results.json, written last, is what marks a complete output.
   constexpr std::size_t kMaxBodiesInSeries = 32;

@@ -4,15 +4,19 @@
 
 #include <poll.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <numbers>
+#include <sstream>
 
 #include "physval/adapters/registry.hpp"
 #include "physval/validation/conservation.hpp"
@@ -265,6 +269,74 @@ bool write_all(int fd, const std::uint8_t* data, std::size_t size) {
   return true;
 }
 
+// --- Child processes die with their parent -----------------------------------------
+// Two mechanisms, because neither covers every way a parent ends:
+//  - SIGKILL of the parent (nothing of it runs): the kernel sends the child
+//    PR_SET_PDEATHSIG. Caveat for future threads: it fires when the *thread* that forked
+//    exits, so fork from a thread that outlives the child.
+//  - SIGTERM/SIGINT of the parent: its handler kills every live child, then ends the
+//    parent with the same signal (so the shell sees the usual status).
+// The table of live children holds several so that parallel runs compose with it.
+
+constexpr std::size_t kMaxLiveChildren = 256;
+std::array<std::atomic<pid_t>, kMaxLiveChildren> g_live_children{};
+
+void kill_live_children_and_reraise(int sig) {
+  for (std::atomic<pid_t>& slot : g_live_children) {
+    const pid_t child = slot.load();
+    if (child > 0) ::kill(child, SIGKILL);
+  }
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+
+void install_child_forwarding_handlers() {
+  static std::atomic<bool> installed{false};
+  if (installed.exchange(true)) return;
+  for (int sig : {SIGTERM, SIGINT, SIGHUP}) {
+    struct sigaction current{};
+    ::sigaction(sig, nullptr, &current);
+    if (current.sa_handler == SIG_IGN) continue;   // e.g. nohup: keep ignoring
+    struct sigaction action{};
+    action.sa_handler = kill_live_children_and_reraise;
+    sigemptyset(&action.sa_mask);
+    ::sigaction(sig, &action, nullptr);
+  }
+}
+
+void remember_live_child(pid_t child) {
+  for (std::atomic<pid_t>& slot : g_live_children) {
+    pid_t expected = 0;
+    if (slot.compare_exchange_strong(expected, child)) return;
+  }
+}
+
+void forget_live_child(pid_t child) {
+  for (std::atomic<pid_t>& slot : g_live_children) {
+    pid_t expected = child;
+    if (slot.compare_exchange_strong(expected, 0)) return;
+  }
+}
+
+// In the forked child, first thing: die when the parent dies. The getppid check closes
+// the race where the parent died between fork and prctl.
+void die_with_parent(pid_t parent) {
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (::getppid() != parent) ::_exit(5);
+  // The parent's forwarding handlers are not for the child: default actions again.
+  for (int sig : {SIGTERM, SIGINT, SIGHUP}) {
+    struct sigaction current{};
+    ::sigaction(sig, nullptr, &current);
+    if (current.sa_handler == kill_live_children_and_reraise) ::signal(sig, SIG_DFL);
+  }
+}
+
+std::string seconds_text(double seconds) {
+  std::ostringstream os;
+  os << seconds;   // 20 -> "20", 0.5 -> "0.5"
+  return os.str();
+}
+
 }  // namespace
 
 RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, const RunOptions& options) {
@@ -273,6 +345,8 @@ RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, 
   if (::pipe(fds) != 0) return run_engine(scene, factory, options);
   std::fflush(stdout);
   std::fflush(stderr);
+  install_child_forwarding_handlers();
+  const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) {
     ::close(fds[0]);
@@ -280,6 +354,7 @@ RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, 
     return run_engine(scene, factory, options);
   }
   if (pid == 0) {
+    die_with_parent(parent);
     ::close(fds[0]);
     int code = 0;
     try {
@@ -292,6 +367,7 @@ RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, 
     ::close(fds[1]);
     ::_exit(code);   // no atexit handlers, no double-flushed stdio buffers
   }
+  remember_live_child(pid);
   ::close(fds[1]);
   std::vector<std::uint8_t> bytes;
   std::uint8_t buffer[1 << 16];
@@ -299,14 +375,17 @@ RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, 
   bool timed_out = false;
   for (;;) {
     int wait_ms = -1;
-    if (options.timeout_seconds > 0.0) {
-      const double left = options.timeout_seconds -
-                          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (options.timeout_seconds > 0.0 || options.deadline) {
+      const auto now = std::chrono::steady_clock::now();
+      double left = options.timeout_seconds > 0.0
+                        ? options.timeout_seconds - std::chrono::duration<double>(now - start).count()
+                        : 1e300;
+      if (options.deadline) left = std::min(left, std::chrono::duration<double>(*options.deadline - now).count());
       if (left <= 0.0) {
         timed_out = true;
         break;
       }
-      wait_ms = static_cast<int>(std::ceil(left * 1000.0));
+      wait_ms = static_cast<int>(std::ceil(std::min(left, 60.0) * 1000.0));
     }
     pollfd p{fds[0], POLLIN, 0};
     const int ready = ::poll(&p, 1, wait_ms);
@@ -319,13 +398,14 @@ RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, 
   }
   ::close(fds[0]);
   if (timed_out) ::kill(pid, SIGKILL);
+  forget_live_child(pid);   // before reaping: an unreaped pid cannot be reused by another process
   int wstatus = 0;
   while (::waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
   }
   RunRecord fallback = blank_record(scene, factory.info);
   fallback.status = RunStatus::Error;
   if (timed_out) {
-    fallback.reason = "timed out after " + std::to_string(options.timeout_seconds) + " s";
+    fallback.reason = "timed out after " + seconds_text(options.timeout_seconds) + " s";
     return fallback;
   }
   if (WIFSIGNALED(wstatus)) {

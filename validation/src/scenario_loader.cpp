@@ -3,6 +3,8 @@
 // line, and every error in a file is collected before giving up.
 #include "physval/validation/scenario_loader.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -54,6 +56,44 @@ std::string format_number(double v) {
   os.precision(10);
   os << v;
   return os.str();
+}
+
+// Bounds checked before anything runs (README: "Bounds").
+constexpr double kMaxEmitterCount = 1e6;   // particles one explode emitter makes
+constexpr double kMaxObjects = 2e5;        // bodies plus every particle emitters can make
+
+// A user's text shown in a message: printable ASCII as is, anything else as \xNN, so a
+// name holding a newline or a terminal escape cannot garble the terminal.
+std::string shown(const std::string& text) {
+  std::string out;
+  for (unsigned char c : text) {
+    if (c >= 0x20 && c < 0x7f && c != '"' && c != '\\') {
+      out += static_cast<char>(c);
+    } else {
+      static const char* hex = "0123456789abcdef";
+      out += "\\x";
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    }
+  }
+  return out;
+}
+
+// "1/120" -> 1/120; nullopt unless the text is NUMBER/NUMBER with a non-zero divisor.
+std::optional<double> parse_fraction(const std::string& text) {
+  const auto slash = text.find('/');
+  if (slash == std::string::npos) return std::nullopt;
+  try {
+    std::size_t used = 0;
+    const std::string a = text.substr(0, slash), b = text.substr(slash + 1);
+    const double num = std::stod(a, &used);
+    if (used != a.size() || a.empty() || std::isspace(static_cast<unsigned char>(a[0]))) return std::nullopt;
+    const double den = std::stod(b, &used);
+    if (used != b.size() || b.empty() || std::isspace(static_cast<unsigned char>(b[0])) || den == 0.0) return std::nullopt;
+    return num / den;
+  } catch (...) {
+    return std::nullopt;
+  }
 }
 
 struct Context {
@@ -111,6 +151,12 @@ class TableReader {
       v = f->get();
     } else if (const auto* i = n.as_integer()) {
       v = static_cast<double>(i->get());
+    } else if (const auto* str = n.as_string(); str != nullptr && parse_fraction(str->get())) {
+      v = *parse_fraction(str->get());   // a fraction in quotes: dt = "1/120"
+    } else if (n.is_string()) {
+      ctx_.error(n.source(), kp, "expected a number, got a string \"" + shown(n.as_string()->get()) +
+                                     "\" (a fraction is written in quotes: \"1/120\")");
+      return std::nullopt;
     } else {
       ctx_.error(n.source(), kp, std::string("expected a number, got ") + type_name(n));
       return std::nullopt;
@@ -624,8 +670,14 @@ void check_references(Context& ctx, const toml::table& root, Scene& s) {
     return root.source();
   };
   std::map<std::string, std::string> names;   // name -> what it is
+  static const std::regex kObjectName("[a-z0-9_]+");
   auto claim = [&](const std::string& name, const std::string& what, std::string_view array, std::size_t i) {
-    if (name.empty()) return;
+    // Names go into CSV headers, plot labels and the terminal: letters, digits, underscores.
+    if (!std::regex_match(name, kObjectName)) {
+      ctx.error(where(array, i, "name"), indexed(std::string(array), i) + ".name",
+                "must match [a-z0-9_]+ (lower-case letters, digits, underscores), got \"" + shown(name) + "\"");
+      return;
+    }
     auto [it, fresh] = names.emplace(name, what);
     if (!fresh) ctx.error(where(array, i, "name"), indexed(std::string(array), i) + ".name",
                           "duplicate name \"" + name + "\" (already used by " + it->second + ")");
@@ -863,7 +915,8 @@ Scene read_scene(Context& ctx, const toml::table& root) {
     er.read_non_negative("at", e.at);
     er.read_non_negative("rate", e.rate);
     double count = 0.0;
-    er.read("count", count, "a whole number >= 0", [](double v) { return v >= 0.0 && v == std::floor(v) && v < 1e8; });
+    er.read("count", count, ("a whole number from 0 to " + format_number(kMaxEmitterCount)).c_str(),
+            [](double v) { return v >= 0.0 && v == std::floor(v) && v <= kMaxEmitterCount; });
     e.count = static_cast<int>(count);
     er.read_non_negative("speed", e.speed);
     er.read("lifetime", e.lifetime, "> 0", [](double v) { return v > 0.0; });
@@ -877,6 +930,26 @@ Scene read_scene(Context& ctx, const toml::table& root) {
     if (e.mode == EmitterMode::Trail && e.rate <= 0.0) er.error_here("rate", "a trail emitter needs rate > 0");
     s.emitters.push_back(e);
   }
+  // Bound before running: bodies plus every particle the emitters can make, and the
+  // memory that takes (about 600 bytes an object: states, samples, contacts; measured
+  // with count = 1e7, which grew to 6 GB) against the machine's.
+  {
+    double particles = 0.0;
+    for (const EmitterDef& e : s.emitters) {
+      particles += e.mode == EmitterMode::Explode ? e.count : std::ceil(e.rate * std::max(s.duration, 0.0));
+    }
+    const double objects = static_cast<double>(s.bodies.size()) + particles;
+    const double bytes = objects * 600.0;
+    const double machine = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+    const std::string what = std::to_string(s.bodies.size()) + (s.bodies.size() == 1 ? " body" : " bodies") +
+                             " and up to " + format_number(particles) + " particles from emitters";
+    if (objects > kMaxObjects) {
+      r.error_here("bodies", what + ": more than physval's bound of " + format_number(kMaxObjects) + " objects");
+    } else if (machine > 0.0 && bytes > 0.5 * machine) {
+      r.error_here("bodies", what + " need about " + format_number(std::round(bytes / 1e6)) + " MB, more than half of " +
+                                 "this machine's " + format_number(std::round(machine / 1e6)) + " MB");
+    }
+  }
   if (const toml::table* c = r.subtable("conserves")) {
     TableReader cr(ctx, *c, "conserves");
     cr.read("energy", s.conserves.energy);
@@ -889,7 +962,10 @@ Scene read_scene(Context& ctx, const toml::table& root) {
     if (const toml::table* t = r.subtable(f.info.name)) read_engine_options(ctx, *t, f.info, s.engine_options[f.info.name]);
   }
   if (s.sample_interval > 0.0 && s.sample_interval < s.dt) {
-    r.error_here("sample_interval", "must be >= dt (" + format_number(s.dt) + ") or 0 for automatic");
+    if (const toml::node* n = root.get("sample_interval")) {
+      r.error_at(*n, "sample_interval", "must be >= dt (" + format_number(s.dt) + ") or 0 for automatic, got " +
+                                            format_number(s.sample_interval));
+    }
   }
   bool allow_initial_overlap = false;
   r.read("allow_initial_overlap", allow_initial_overlap);
@@ -957,6 +1033,16 @@ SuiteLoad load_suite(const std::vector<std::string>& paths) {
       out.errors.push_back({p, 0, 0, "", "no such file or folder"});
     }
   }
+  // The same file given twice (directly and through its folder, or twice) is loaded once.
+  std::set<std::filesystem::path> distinct;
+  std::vector<std::filesystem::path> unique_files;
+  for (const auto& f : files) {
+    std::error_code ec;
+    std::filesystem::path canonical = std::filesystem::weakly_canonical(f, ec);
+    if (ec) canonical = f;
+    if (distinct.insert(canonical).second) unique_files.push_back(f);
+  }
+  files = std::move(unique_files);
   std::map<std::string, std::string> seen;   // scenario name -> file
   for (const auto& f : files) {
     ScenarioLoad one = load_scenario_file(f);

@@ -57,16 +57,11 @@ SuiteResult run_suite(const std::vector<Scene>& scenes, const std::vector<std::s
   }
 
   std::mutex progress_mutex;
-  std::size_t started = 0;
   auto say = [&](const Task& t) {
     if (!progress) return;
     const std::lock_guard<std::mutex> lock(progress_mutex);
-    ++started;
     const std::string what = result.scenarios[t.scenario].scene.name + ": " + (t.engine ? t.engine->info.name : "reference");
-    if (jobs <= 1) return progress(what);
-    std::ostringstream line;
-    line << '[' << started << '/' << tasks.size() << "] " << what;
-    progress(line.str());
+    progress(what);   // the caller counts scenarios (physval's "[n/N]")
   };
   run_tasks(costs, jobs, [&](std::size_t i) {
     const Task& t = tasks[i];

@@ -19,6 +19,29 @@ nlohmann::json suite_to_json(const SuiteResult& result);
 // rename). Creates the folder. Throws std::runtime_error on failure.
 void write_file_atomically(const std::filesystem::path& path, const std::string& text);
 
+// An output folder that appears whole or not at all. The constructor checks the final
+// folder before anything runs (not a file; an existing folder is replaced only when it
+// is empty or holds a results.json, i.e. an earlier physval output) and creates a staging
+// folder beside it, ".NAME.staging.PID"; everything is written there, and commit()
+// swaps it into place with renames. Not committed (an exception, a kill): the staging
+// folder is removed (or left, on SIGKILL) and the final folder is untouched.
+// Throws std::runtime_error with a message naming the folder.
+class StagedOutputFolder {
+ public:
+  explicit StagedOutputFolder(std::filesystem::path final_dir);
+  ~StagedOutputFolder();
+  StagedOutputFolder(const StagedOutputFolder&) = delete;
+  StagedOutputFolder& operator=(const StagedOutputFolder&) = delete;
+  const std::filesystem::path& staging() const { return staging_; }
+  const std::filesystem::path& final_dir() const { return final_; }
+  void commit();
+
+ private:
+  std::filesystem::path final_;
+  std::filesystem::path staging_;
+  bool committed_ = false;
+};
+
 // DIR/results.json, plus DIR/series/<scenario>/<engine>.csv (time series for plots:
 // t, energy, kinetic, potential, px, py, angular_momentum, then x_i, y_i of each body).
 void write_results(const std::filesystem::path& dir, const SuiteResult& result);

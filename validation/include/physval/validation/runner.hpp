@@ -2,6 +2,7 @@
 // engine that crashes or hangs costs only its own run.
 #pragma once
 
+#include <chrono>
 #include <functional>
 #include <optional>
 #include <string>
@@ -17,6 +18,9 @@ struct RunOptions {
   std::optional<double> duration;    // overrides the scenario's duration
   bool isolate = true;               // run each engine in a child process
   double timeout_seconds = 0.0;      // per run; 0: none
+  // A shared end for several runs that count as one (the reference's two runs): an
+  // isolated run stops at the earlier of its timeout and this deadline.
+  std::optional<std::chrono::steady_clock::time_point> deadline;
   // Bound on stored samples x bodies (memory); the sample interval grows to fit.
   std::size_t max_sample_states = 4'000'000;
   // Folder of the reference cache (see reference_cache.hpp); empty: no cache.
