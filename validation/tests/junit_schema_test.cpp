@@ -34,11 +34,11 @@ SuiteResult every_kind_of_run() {
   ScenarioResult sr;
   sr.scene.name = "two";
   RunRecord ok = record("ok_engine", RunStatus::Ok);
-  ok.checks.push_back({"energy_drift", 1e-9, 1e-12, true, true});
+  ok.checks.push_back({"energy_drift", 1e-9, 1e-12, true, true, false, ""});
   RunRecord failed = record("failing_engine", RunStatus::Ok);
-  failed.checks.push_back({"energy_drift", 1e-9, 0.5, false, true});
-  failed.checks.push_back({"expect.final.a.velocity", 0.01, 0.0411, false, true});
-  failed.checks.push_back({"position_divergence", 1e-3, 5.0, false, false});   // not enforced: not listed
+  failed.checks.push_back({"energy_drift", 1e-9, 0.5, false, true, false, ""});
+  failed.checks.push_back({"expect.final.a.velocity", 0.01, 0.0411, false, true, false, ""});
+  failed.checks.push_back({"position_divergence", 1e-3, 5.0, false, false, false, ""});   // not enforced: not listed
   RunRecord crashed = record("crashing_engine", RunStatus::Error, "engine crashed: signal 11 (Segmentation fault)");
   RunRecord timed_out = record("slow_engine", RunStatus::Error, "timed out after 20 s");
   RunRecord skipped = record("blind_engine", RunStatus::Unsupported, "cannot model: particles");

@@ -270,7 +270,7 @@ TEST(Gate, JunitHasACasePerScenarioAndEngine) {
   RunRecord ok = run_engine(sr.scene, fake(Fault::None), RunOptions{});
   RunRecord bad = ok;
   bad.engine = "other<&>";
-  bad.checks.push_back({"energy_drift", 1e-9, 1.0, false, true});
+  bad.checks.push_back({"energy_drift", 1e-9, 1.0, false, true, false, ""});
   RunRecord skipped = unsupported_run(sr.scene, fake(Fault::None).info, {"particles"});
   sr.runs = {ok, bad, skipped};
   result.scenarios.push_back(sr);

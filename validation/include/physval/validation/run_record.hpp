@@ -58,6 +58,9 @@ struct Check {
   // An expectation the engine misses, accepted up to a recorded bound
   // ([gate.<engine>] known_failures): `limit` is then that bound, not the tolerance.
   bool known_failure = false;
+  // For an expectation: what was measured and what was expected, in the scene's units
+  // ("measured [1.0, 0.0] m/s, expected [1.5, 0.0] m/s"), for people reading a miss.
+  std::string detail;
 };
 
 using Metrics = std::map<std::string, std::optional<double>>;
