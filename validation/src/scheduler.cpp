@@ -23,6 +23,13 @@ std::size_t default_jobs() {
 
 void run_tasks(const std::vector<double>& costs, std::size_t jobs, const std::function<void(std::size_t)>& task) {
   const std::size_t n = costs.size();
+#if defined(__SANITIZE_ADDRESS__)
+  // Each task forks an engine child. In the sanitizer build a child forked while another
+  // thread is inside the AddressSanitizer runtime can inherit its locks held and hang
+  // (seen with GCC 12's libasan), so that build runs tasks one at a time. Release builds,
+  // whose glibc makes fork safe for malloc and stdio, keep the threads.
+  jobs = 1;
+#endif
   if (jobs <= 1 || n <= 1) {
     for (std::size_t i = 0; i < n; ++i) task(i);
     return;
