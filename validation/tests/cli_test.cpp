@@ -2,6 +2,8 @@
 // and key, results.json whole, gate failures, JUnit XML a parser accepts.
 #include <gtest/gtest.h>
 
+#include "physval_command.hpp"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -17,23 +19,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int status = -1;
-  std::string output;   // stdout and stderr
-};
-
-Result physval(const std::string& args) {
-  Result r;
-  const std::string cmd = std::string(PHYSVAL_EXE) + " " + args + " 2>&1";
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-  const int w = ::pclose(p);
-  r.status = WIFEXITED(w) ? WEXITSTATUS(w) : -1;
-  return r;
-}
+using physval_test::Result;
+using physval_test::physval;
 
 class Cli : public ::testing::Test {
  protected:

@@ -4,6 +4,8 @@
 // the bounds from a run.
 #include <gtest/gtest.h>
 
+#include "physval_command.hpp"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -19,23 +21,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int status = -1;
-  std::string output;
-};
-
-Result physval(const std::string& args) {
-  Result r;
-  const std::string cmd = std::string(PHYSVAL_EXE) + " " + args + " 2>&1";
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-  const int w = ::pclose(p);
-  r.status = WIFEXITED(w) ? WEXITSTATUS(w) : -1;
-  return r;
-}
+using physval_test::Result;
+using physval_test::physval;
 
 std::string read(const fs::path& p) {
   std::ifstream in(p);

@@ -2,6 +2,8 @@
 // the CLI messages around them, run through the real executable where a user meets them.
 #include <gtest/gtest.h>
 
+#include "physval_command.hpp"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -132,22 +134,8 @@ TEST_F(LoaderFiles, AFileGivenTwiceIsLoadedOnceNotUsedByItself) {
   EXPECT_EQ(load.scenes.size(), 1u);
 }
 
-struct Result {
-  int status = -1;
-  std::string output;
-};
-
-Result physval(const std::string& args) {
-  Result r;
-  FILE* p = ::popen((std::string(PHYSVAL_EXE) + " " + args + " 2>&1").c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-  const int w = ::pclose(p);
-  r.status = WIFEXITED(w) ? WEXITSTATUS(w) : -1;
-  return r;
-}
+using physval_test::Result;
+using physval_test::physval;
 
 TEST_F(LoaderFiles, SweepGivenAFolderSaysSo) {
   const Result r = physval("sweep " + dir_.string());

@@ -3,6 +3,8 @@
 // bounds the reference's runs too, and the CLI messages a user meets.
 #include <gtest/gtest.h>
 
+#include "physval_command.hpp"
+
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -20,23 +22,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int status = -1;
-  std::string output;   // stdout and stderr
-};
-
-Result physval(const std::string& args) {
-  Result r;
-  const std::string cmd = std::string(PHYSVAL_EXE) + " " + args + " 2>&1";
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-  const int w = ::pclose(p);
-  r.status = WIFEXITED(w) ? WEXITSTATUS(w) : -1;
-  return r;
-}
+using physval_test::Result;
+using physval_test::physval;
 
 // Starts physval with these arguments, output to a file; returns its pid.
 pid_t spawn_physval(const std::vector<std::string>& args, const fs::path& log) {

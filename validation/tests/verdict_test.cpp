@@ -2,6 +2,8 @@
 // must not pass. Each test here failed before its fix.
 #include <gtest/gtest.h>
 
+#include "physval_command.hpp"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -14,23 +16,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int status = -1;
-  std::string output;   // stdout and stderr
-};
-
-Result physval(const std::string& args) {
-  Result r;
-  const std::string cmd = std::string(PHYSVAL_EXE) + " " + args + " 2>&1";
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) r.output.append(buf, n);
-  const int w = ::pclose(p);
-  r.status = WIFEXITED(w) ? WEXITSTATUS(w) : -1;
-  return r;
-}
+using physval_test::Result;
+using physval_test::physval;
 
 bool has(const Result& r, const std::string& text) { return r.output.find(text) != std::string::npos; }
 
