@@ -82,7 +82,9 @@ void add_common(CLI::App* cmd, CommonOptions& o) {
   cmd->add_option("--dt", o.dt, "override every scenario's step, seconds (1/60 or 0.0166)");
   cmd->add_option("--duration", o.duration, "override every scenario's duration, seconds");
   cmd->add_flag("--no-isolate", o.no_isolate, "run engines in this process (debugging; a crash then ends physval)");
-  cmd->add_option("--timeout", o.timeout, "seconds a single engine run may take before it is stopped (0: no limit)");
+  cmd->add_option("--timeout", o.timeout,
+                  "seconds an engine run and the reference it is compared with may take together; the run is "
+                  "stopped when they exceed it (0: no limit)");
   cmd->add_flag("--quiet", o.quiet, "print only the summary line");
   cmd->add_option("--cache", o.cache, "reference cache folder (default $XDG_CACHE_HOME/physval/references or ~/.cache/...)");
   cmd->add_flag("--no-cache", o.no_cache, "compute every reference, read and write no cache");

@@ -330,8 +330,10 @@ Reference make_reference(const Scene& scene, const RunOptions& options) {
   }
   const Scene fine = variant(refine);
   const Scene coarse = variant(refine / 2);
+  const auto started = std::chrono::steady_clock::now();
   RunRecord fine_run = run_engine_isolated(fine, *engine, ro);
-  RunRecord coarse_run = run_engine_isolated(coarse, *engine, ro);
+  RunRecord coarse_run = fine_run.status == RunStatus::Ok ? run_engine_isolated(coarse, *engine, ro) : fine_run;
+  ref.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   ref.dt = fine.dt;
   if (fine_run.status != RunStatus::Ok || coarse_run.status != RunStatus::Ok) {
     const RunRecord& bad = fine_run.status != RunStatus::Ok ? fine_run : coarse_run;

@@ -1,0 +1,87 @@
+// Budgets and bounds a user meets before and while running (issue 10): one --timeout for
+// an engine run and the reference it needs; huge files refused while they are read, with
+// a memory estimate; `physval engines` showing each option's range. Each test failed
+// before its fix.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "physval_command.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+using physval_test::Result;
+using physval_test::physval;
+
+bool has(const Result& r, const std::string& text) { return r.output.find(text) != std::string::npos; }
+
+class Budget : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("physval_budget_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path write(const std::string& name, const std::string& text) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p;
+  }
+  nlohmann::json results() const {
+    std::ifstream in(dir_ / "out" / "results.json");
+    return nlohmann::json::parse(in);
+  }
+  std::string out() const { return " --quiet --no-cache --out " + (dir_ / "out").string(); }
+  fs::path dir_;
+};
+
+// 400 bodies in a box of walls for 8 s: core's reference (two exact runs at dt/8 and
+// dt/4) costs seconds; one Box2D run at dt a tenth of that.
+std::string slow_reference_gas() {
+  std::ostringstream s;
+  s << "name = \"slowref\"\nduration = 8.0\ndt = 0.0166666666666666667\nengines = [\"core\", \"box2d\"]\n";
+  for (int i = 0; i < 20; ++i) {
+    for (int j = 0; j < 20; ++j) {
+      const double a = 0.37 * (i * 20 + j);
+      s << "[[bodies]]\nname = \"b" << i << "_" << j << "\"\nradius = 0.1\nposition = [" << -4 + 0.4 * i << ", "
+        << -4 + 0.4 * j << "]\nvelocity = [" << 3 * std::cos(a) << ", " << 3 * std::sin(a) << "]\n";
+    }
+  }
+  const char* corners[] = {"[-5.0, -5.0]", "[5.0, -5.0]", "[5.0, 5.0]", "[-5.0, 5.0]"};
+  for (int k = 0; k < 4; ++k) s << "[[walls]]\nfrom = " << corners[k] << "\nto = " << corners[(k + 1) % 4] << "\n";
+  s << "[gate]\nescaped_bodies = 0\n";
+  return s.str();
+}
+
+// A slow reference and a fast engine: before, the reference had its own --timeout and the
+// engine run another, so the engine run came out `ok` after more than S in all. Now the
+// reference's time is taken from the engine run's budget.
+TEST_F(Budget, TimeoutBoundsAnEngineRunTogetherWithItsReference) {
+  const fs::path f = write("slowref.toml", slow_reference_gas());
+  // Unbounded, the Box2D run is ok: only the budget can make it fail.
+  ASSERT_EQ(physval("run --engines box2d " + f.string() + out()).status, 0);
+  ASSERT_EQ(results()["runs"][0]["status"], "ok");
+
+  const Result r = physval("run --engines box2d --timeout 1 " + f.string() + out());
+  EXPECT_EQ(r.status, 1) << r.output;
+  const nlohmann::json run = results()["runs"][0];
+  EXPECT_EQ(run["status"], "error") << run.dump();
+  const std::string reason = run["reason"];
+  EXPECT_EQ(reason.rfind("timed out", 0), 0u) << reason;   // JUnit's <error type="timeout">
+  EXPECT_NE(reason.find("--timeout budget of 1 s"), std::string::npos) << reason;
+}
+
+}  // namespace
