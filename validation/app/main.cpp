@@ -276,8 +276,11 @@ void print_engines(bool as_json) {
       for (Feature ft : f.info.features) features.push_back(feature_name(ft));
       nlohmann::json options = nlohmann::json::array();
       for (const OptionSpec& s : f.info.options) {
+        const bool numeric = s.default_value.index() == 1 || s.default_value.index() == 2;
         options.push_back({{"key", s.key}, {"type", option_type_name(s.default_value)},
-                           {"default", option_value_to_string(s.default_value)}, {"choices", s.choices}, {"doc", s.doc}});
+                           {"default", option_value_to_string(s.default_value)}, {"choices", s.choices},
+                           {"range", numeric ? nlohmann::json(s.range.describe()) : nlohmann::json(nullptr)},
+                           {"doc", s.doc}});
       }
       out.push_back({{"name", f.info.name}, {"version", f.info.version}, {"precision", precision_name(f.info.precision)},
                      {"summary", f.info.summary}, {"features", features}, {"options", options},
@@ -317,6 +320,7 @@ void print_engines(bool as_json) {
         std::cout << ":";
         for (std::size_t i = 0; i < s.choices.size(); ++i) std::cout << (i ? "|" : " ") << s.choices[i];
       }
+      if (s.default_value.index() == 1 || s.default_value.index() == 2) std::cout << ", " << s.range.describe();
       std::cout << ")  " << s.doc << '\n';
     }
     std::cout << '\n';

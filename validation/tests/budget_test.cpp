@@ -85,3 +85,29 @@ TEST_F(Budget, TimeoutBoundsAnEngineRunTogetherWithItsReference) {
 }
 
 }  // namespace
+
+namespace {
+
+// `physval engines` showed each option's default but not the values `check` accepts.
+TEST(EnginesCommand, ListsEachNumericOptionsRange) {
+  const Result text = physval("engines");
+  ASSERT_EQ(text.status, 0) << text.output;
+  EXPECT_TRUE(has(text, "velocity_iterations = 8  (integer, in [1, 100000])")) << text.output;
+  EXPECT_TRUE(has(text, "erp = 0.2  (float, in [0, 1])")) << text.output;
+  EXPECT_TRUE(has(text, "max_events_per_step = 0  (integer, in [0, 1e+09])")) << text.output;
+  const Result json = physval("engines --json");
+  ASSERT_EQ(json.status, 0);
+  const nlohmann::json engines = nlohmann::json::parse(json.output);
+  int numeric = 0;
+  for (const nlohmann::json& e : engines) {
+    for (const nlohmann::json& o : e["options"]) {
+      const bool is_numeric = o["type"] == "integer" || o["type"] == "float";
+      ASSERT_TRUE(o.contains("range")) << o.dump();
+      EXPECT_EQ(o["range"].is_string(), is_numeric) << o.dump();
+      numeric += is_numeric ? 1 : 0;
+    }
+  }
+  EXPECT_GT(numeric, 10);
+}
+
+}  // namespace
