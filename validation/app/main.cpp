@@ -70,7 +70,16 @@ struct CommonOptions {
   int jobs = 0;   // 0: every core
   std::string cache;
   bool no_cache = false;
+  double max_memory_mb = 0.0;
 };
+
+// --max-memory MB: the limit the memory estimate of each scene is held to (0: half of the
+// machine's). NaN and negative values are bad input.
+bool apply_max_memory(double mb) {
+  if (!(mb >= 0.0) || !std::isfinite(mb)) return false;
+  if (mb > 0.0) set_memory_limit_bytes(mb * 1e6);
+  return true;
+}
 
 void add_common(CLI::App* cmd, CommonOptions& o) {
   cmd->add_option("PATH", o.paths, "scenario files (*.toml) or folders of them (searched recursively)")->required();
@@ -88,6 +97,8 @@ void add_common(CLI::App* cmd, CommonOptions& o) {
   cmd->add_flag("--quiet", o.quiet, "print only the summary line");
   cmd->add_option("--cache", o.cache, "reference cache folder (default $XDG_CACHE_HOME/physval/references or ~/.cache/...)");
   cmd->add_flag("--no-cache", o.no_cache, "compute every reference, read and write no cache");
+  cmd->add_option("--max-memory", o.max_memory_mb,
+                  "MB a scene's estimated memory may reach (default 0: half of this machine's memory)");
   cmd->add_option("-j,--jobs", o.jobs, "references and engine runs at once (default 0: every core); results do not depend on it");
 }
 
@@ -187,11 +198,19 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
   if (!(baseline_factor >= 1.0) || !std::isfinite(baseline_factor)) {
     return bad_input("--baseline-factor must be a finite number >= 1");   // NaN too
   }
+  if (!apply_max_memory(o.max_memory_mb)) return bad_input("--max-memory must be a number of MB >= 0");
   auto scenes = load_or_report(o.paths);
   if (!scenes) return kExitBadInput;
   for (const Scene& s : *scenes) {
-    if (const std::string too_many = scene_steps_error(effective_scene(s, options)); !too_many.empty()) {
+    const Scene effective = effective_scene(s, options);
+    if (const std::string too_many = scene_steps_error(effective); !too_many.empty()) {
       return bad_input(s.source_file + ": with --duration/--dt: " + too_many);
+    }
+    if (options.dt || options.duration) {
+      if (const std::string too_big = memory_bound_error(effective, engines_for(effective, o.engines).size());
+          !too_big.empty()) {
+        return bad_input(s.source_file + ": with --duration/--dt: the scene " + too_big + "; nothing was run");
+      }
     }
   }
   // --out is checked (and a staging folder made beside it) before anything runs.
@@ -361,8 +380,11 @@ int main(int argc, char** argv) {
   gate->add_flag("--report", gate_report, "also write DIR/report.html with plots");
 
   std::vector<std::string> check_paths;
+  double check_max_memory = 0.0;
   auto* check = app.add_subcommand("check", "parse and validate scenario files; runs nothing");
   check->add_option("PATH", check_paths, "scenario files or folders")->required();
+  check->add_option("--max-memory", check_max_memory,
+                    "MB a scene's estimated memory may reach (default 0: half of this machine's memory)");
 
   std::string sweep_scenario, sweep_out = "physval-sweep", sweep_duration;
   std::vector<std::string> sweep_dts, sweep_engines;
@@ -407,6 +429,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*check) {
+      if (!apply_max_memory(check_max_memory)) return bad_input("--max-memory must be a number of MB >= 0");
       auto scenes = load_or_report(check_paths);
       if (!scenes) return kExitBadInput;
       for (const Scene& s : *scenes) {
