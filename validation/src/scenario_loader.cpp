@@ -774,6 +774,53 @@ void check_initial_overlaps(Context& ctx, const toml::table& root, const Scene& 
       ++reported;
     }
   }
+  // A body inside a barrier (a wall, a box side, a surface segment) it collides with: each
+  // engine pushes it out its own way, or lets it fall through.
+  struct Piece {
+    Vec2 a, b;
+    const std::string* what;
+    const std::string* group;
+  };
+  std::vector<Piece> pieces;
+  std::vector<std::string> names;
+  names.reserve(s.walls.size() + s.boxes.size() + s.surfaces.size());
+  for (const WallDef& w : s.walls) {
+    names.push_back("wall \"" + w.name + "\"");
+    pieces.push_back({w.from, w.to, &names.back(), &w.material.group});
+  }
+  for (const BoxDef& b : s.boxes) {
+    names.push_back("box \"" + b.name + "\"");
+    const Vec2 c[4] = {b.min, {b.max.x, b.min.y}, b.max, {b.min.x, b.max.y}};
+    for (int k = 0; k < 4; ++k) pieces.push_back({c[k], c[(k + 1) % 4], &names.back(), &b.material.group});
+  }
+  for (const SurfaceDef& f : s.surfaces) {
+    names.push_back("surface \"" + f.name + "\"");
+    for (std::size_t k = 0; k + 1 < f.points.size(); ++k) {
+      pieces.push_back({f.points[k], f.points[k + 1], &names.back(), &f.material.group});
+    }
+  }
+  for (std::size_t i = 0; i < s.bodies.size() && reported < 5; ++i) {
+    const BodyDef& d = s.bodies[i];
+    if (d.is_static || d.shape == ShapeKind::Point || !(d.radius > 0.0)) continue;
+    for (const Piece& p : pieces) {
+      const Vec2 ab = p.b - p.a;
+      const double len2 = dot(ab, ab);
+      const double u = len2 > 0.0 ? std::clamp(dot(d.position - p.a, ab) / len2, 0.0, 1.0) : 0.0;
+      const double depth = d.radius - length(d.position - (p.a + ab * u));
+      if (depth <= 1e-9 * d.radius + 1e-12) continue;
+      if (!response_between(s, d.group, *p.group).collide) continue;
+      const toml::node* at = array != nullptr && i < array->size() ? array->get(i) : nullptr;
+      if (const auto* t = at != nullptr ? at->as_table() : nullptr; t != nullptr && t->get("position") != nullptr) {
+        at = t->get("position");
+      }
+      char text[200];
+      std::snprintf(text, sizeof text, "overlaps %s by %.3g m at t = 0", p.what->c_str(), depth);
+      ctx.error(at != nullptr ? at->source() : root.source(), indexed("bodies", i) + ".position",
+                std::string(text) + " (set allow_initial_overlap = true at the top level if you mean it)");
+      ++reported;
+      break;
+    }
+  }
 }
 
 Scene read_scene(Context& ctx, const toml::table& root) {

@@ -158,3 +158,28 @@ TEST_F(Budget, MemoryEstimateCountsSamplesAndIsRefusedPastTheLimit) {
 }
 
 }  // namespace
+
+namespace {
+
+// A user's scene: a ball placed 0.3 m into the floor. It passed `check`, and `gate` with
+// escaped_bodies = 0 was green on all three engines while core missed 29 contacts.
+TEST_F(Budget, ABodyInsideAWallAtTheStartIsAnError) {
+  const std::string head = "name = \"stuck\"\nduration = 1.0\n[world]\ngravity = [0.0, -9.8]\n"
+                           "[[bodies]]\nname = \"ball\"\nradius = 0.5\n";
+  const std::string floor = "[[walls]]\nname = \"floor\"\nfrom = [-5.0, 0.0]\nto = [5.0, 0.0]\n";
+  const fs::path f = write("stuck.toml", head + "position = [0.0, 0.2]\n" + floor);
+  const Result r = physval("check " + f.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_TRUE(has(r, f.string() + ":8:12: bodies[0].position: overlaps wall \"floor\" by 0.3 m at t = 0")) << r.output;
+  // Inside a box's side and a surface segment too; touching is not overlapping.
+  const fs::path g = write("box.toml", head + "position = [0.0, 1.2]\n[[boxes]]\nname = \"crate\"\nmin = [-1.0, 1.0]\nmax = [1.0, 3.0]\n");
+  EXPECT_TRUE(has(physval("check " + g.string()), "overlaps box \"crate\" by 0.3 m"));
+  const fs::path h = write("surface.toml", head + "position = [0.0, 0.1]\n[[surfaces]]\nname = \"ramp\"\npoints = [[-2.0, 0.0], [2.0, 0.0]]\n");
+  EXPECT_TRUE(has(physval("check " + h.string()), "overlaps surface \"ramp\" by 0.4 m"));
+  const fs::path touching = write("touching.toml", head + "position = [0.0, 0.5]\n" + floor);
+  EXPECT_EQ(physval("check " + touching.string()).status, 0);
+  const fs::path allowed = write("allowed.toml", "allow_initial_overlap = true\n" + head + "position = [0.0, 0.2]\n" + floor);
+  EXPECT_EQ(physval("check " + allowed.string()).status, 0);
+}
+
+}  // namespace
