@@ -122,7 +122,7 @@ void print_suite_table(std::ostream& os, const SuiteResult& result) {
       for (const Check& c : r.checks) {
         if (c.pass) continue;
         const std::string limit = c.known_failure ? "bound " : c.what.rfind("expect.", 0) == 0 ? "tolerance " : "limit ";
-        const std::string sep = c.detail.empty() && !c.value ? "" : ", ";
+        const std::string sep = c.detail.empty() ? "" : ", ";   // "value 1 (limit 0)", "... (off by 2, tolerance 1)"
         if (c.enforced) {
           note(os, r.engine + " FAILED " + c.what + ": " + off(c) + sep + limit + num(c.limit, "%.3g") + ")");
         } else {
