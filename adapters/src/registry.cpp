@@ -1,19 +1,47 @@
 #include "physval/adapters/registry.hpp"
 
+#include <cstdlib>
+
 #include "physval/adapters/box2d_adapter.hpp"
 #include "physval/adapters/bullet_adapter.hpp"
+#include "physval/adapters/plugin_engine.hpp"
 #include "physval/core/core_engine.hpp"
 
 namespace physval {
 
-const std::vector<EngineFactory>& engine_registry() {
-  static const std::vector<EngineFactory> engines = [] {
+namespace {
+
+std::vector<EngineFactory>& mutable_registry() {
+  static std::vector<EngineFactory> engines = [] {
     std::vector<EngineFactory> all = {core_engine_factory(), box2d_engine_factory(), bullet_engine_factory()};
     // core, run with RK4 and event-driven impacts, is the reference.
     all[0].reference_options = {{"integrator", std::string("rk4")}, {"collision", std::string("exact")}};
     return all;
   }();
   return engines;
+}
+
+}  // namespace
+
+const std::vector<EngineFactory>& engine_registry() { return mutable_registry(); }
+
+void register_engine(EngineFactory factory) {
+  if (const EngineFactory* same = find_engine(factory.info.name)) {
+    throw PluginError("engine \"" + factory.info.name + "\" is already registered (" + same->info.summary +
+                      "): each engine needs a name of its own");
+  }
+  mutable_registry().push_back(std::move(factory));
+}
+
+std::vector<std::string> register_plugins(const std::vector<std::string>& args) {
+  const char* env = std::getenv("PHYSVAL_PLUGIN_PATH");
+  std::vector<std::string> names;
+  for (const std::string& arg : args) {
+    EngineFactory f = load_plugin(resolve_plugin_path(arg, env == nullptr ? "" : env));
+    names.push_back(f.info.name);
+    register_engine(std::move(f));
+  }
+  return names;
 }
 
 const EngineFactory* find_engine(const std::string& name) {
