@@ -8,9 +8,10 @@
 //      index order, apply the impulse j = -(1 + e) v_n / (1/m_a + 1/m_b) along the normal;
 //   3. push overlapping pairs apart by position_correction x the overlap, split by inverse
 //      mass (0: no correction, 1: separate fully).
-// A contact begins when a pair overlaps at the end of a step and did not at the end of the
-// previous one; its time is the end of that step. The pair's material is physval's rule,
-// asked of the host (min restitution, overrides by name). No friction, no spin.
+// A contact begins when a pair touches at the end of a step and did not at the end of the
+// previous one (or at load); its time is the end of that step. The pair's material is
+// physval's rule, asked of the host (min restitution, overrides by name). No friction, no
+// spin.
 #include <physval/plugin.hpp>
 
 #include <algorithm>
@@ -96,6 +97,7 @@ class Discs {
       const physval_material& m = s.walls[i].material;
       walls_[i].material = {walls_[i].name.c_str(), m.restitution, m.friction, m.static_friction, m.rolling_friction};
     }
+    touching_ = touching();   // pairs that touch at the start have not begun a contact
   }
 
   void step(double dt) {
