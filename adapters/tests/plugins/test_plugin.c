@@ -5,6 +5,7 @@
  *   0 ballistic  the honest engine                 3 wrongabi  reports ABI version 99
  *   1 crashy     dereferences NULL at t >= 0.05 s  4 nanny     velocities turn NaN at t >= 0.05 s
  *   2 hangy      never returns from step at 0.05 s 5 failing   step reports an error at 0.05 s
+ *   6 strained   reports a limit hit from 0.05 s on and a broken guarantee in the step that ends past 0.1 s
  */
 #include <math.h>
 #include <stdio.h>
@@ -27,8 +28,10 @@
 #define NAME "wrongabi"
 #elif TEST_PLUGIN_MODE == 4
 #define NAME "nanny"
-#else
+#elif TEST_PLUGIN_MODE == 5
 #define NAME "failing"
+#else
+#define NAME "strained"
 #endif
 
 #define TROUBLE_AT 0.05
@@ -169,15 +172,15 @@ static void settings(const physval_engine* e, const physval_setting** out, size_
   *count = 2;
 }
 
+static const char* const kLimits[1] = {"speed clamp: a body was held at 100 m/s"};
+
 static void limits_hit(const physval_engine* e, const char* const** out, size_t* count) {
-  (void)e;
-  *out = NULL;
-  *count = 0;
+  *out = kLimits;
+  *count = TEST_PLUGIN_MODE == 6 && e->t >= TROUBLE_AT ? 1 : 0;
 }
 
 static const char* broken_guarantee(const physval_engine* e) {
-  (void)e;
-  return "";
+  return TEST_PLUGIN_MODE == 6 && e->t > 2 * TROUBLE_AT + 1e-9 ? "event cap reached: impacts no longer exact" : "";
 }
 
 PHYSVAL_PLUGIN_EXPORT const physval_plugin_table_v1* physval_plugin_v1(uint32_t host_abi_version) {
