@@ -1,6 +1,8 @@
 #include "physval/adapters/registry.hpp"
 
+#include <algorithm>
 #include <cstdlib>
+#include <filesystem>
 
 #include "physval/adapters/box2d_adapter.hpp"
 #include "physval/adapters/bullet_adapter.hpp"
@@ -33,9 +35,32 @@ void register_engine(EngineFactory factory) {
   mutable_registry().push_back(std::move(factory));
 }
 
+std::vector<std::string> bundled_plugin_paths() {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return {};
+  std::vector<std::string> out;
+  for (const fs::path& dir : {exe.parent_path() / "plugins", exe.parent_path() / ".." / "lib" / "physval" / "plugins"}) {
+    std::vector<std::string> here;
+    for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+      if (e.is_regular_file() && e.path().extension() == ".so") here.push_back(e.path().string());
+    }
+    std::sort(here.begin(), here.end());
+    out.insert(out.end(), here.begin(), here.end());
+    if (!here.empty()) break;   // the build tree's, or else the installed ones
+  }
+  return out;
+}
+
 std::vector<std::string> register_plugins(const std::vector<std::string>& args) {
   const char* env = std::getenv("PHYSVAL_PLUGIN_PATH");
   std::vector<std::string> names;
+  for (const std::string& path : bundled_plugin_paths()) {
+    EngineFactory f = load_plugin(path);
+    names.push_back(f.info.name);
+    register_engine(std::move(f));
+  }
   for (const std::string& arg : args) {
     EngineFactory f = load_plugin(resolve_plugin_path(arg, env == nullptr ? "" : env));
     names.push_back(f.info.name);

@@ -136,6 +136,29 @@ TEST(PluginCli, SearchPathVariableFindsThePluginByName) {
   EXPECT_EQ(last["options"][0]["default"], "1");
 }
 
+// Bundled plugins load with every command, from beside the executable: <bin>/plugins in a
+// build tree, <bin>/../lib/physval/plugins in an installed physval.
+TEST(PluginCli, BundledPluginsLoadWithoutTheOption) {
+  for (const std::string layout : {"bin/plugins", "lib/physval/plugins"}) {
+    const fs::path d = temp_dir("bundled");
+    fs::create_directories(d / "bin");
+    fs::create_directories(d / layout);
+    fs::copy_file(PHYSVAL_EXE, d / "bin" / "physval");
+    fs::copy_file(lib("ballistic"), d / layout / "ballistic.so");
+    const std::string exe = (d / "bin" / "physval").string();
+    FILE* p = ::popen((exe + " engines --json").c_str(), "r");
+    ASSERT_NE(p, nullptr);
+    std::string text;
+    char buf[4096];
+    std::size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) text.append(buf, n);
+    ASSERT_EQ(::pclose(p), 0) << text;
+    EXPECT_EQ(nlohmann::json::parse(text).back()["name"], "ballistic") << layout;
+    // And its [gate.ballistic] tables are then known to `check`.
+    EXPECT_EQ(std::system((exe + " check " + kScenarios + " > /dev/null").c_str()), 0) << layout;
+  }
+}
+
 TEST(PluginCli, CheckValidatesThePluginsOptions) {
   const fs::path d = temp_dir("check");
   std::ifstream in(kScenarios + "/projectile.toml");
