@@ -111,6 +111,9 @@ Conserved conserved_quantities(const Scene& scene) {
   else c.energy_why = "elastic, frictionless, no drag or thrust";
   c.energy = c.energy_why == "elastic, frictionless, no drag or thrust";
 
+  const bool wind = scene.world.wind.x != 0.0 || scene.world.wind.y != 0.0;
+  c.energy_non_increasing = !thrust && !particles && !(drag && wind);
+
   if (scene.conserves.energy) {
     c.energy = *scene.conserves.energy;
     c.energy_why = "declared by the scenario";
