@@ -146,7 +146,7 @@ TEST(PluginCli, BundledPluginsLoadWithoutTheOption) {
     fs::copy_file(PHYSVAL_EXE, d / "bin" / "physval");
     fs::copy_file(lib("ballistic"), d / layout / "ballistic.so");
     const std::string exe = (d / "bin" / "physval").string();
-    FILE* p = ::popen((exe + " engines --json").c_str(), "r");
+    FILE* p = ::popen(("env -u PHYSVAL_BUNDLED_PLUGIN_DIR " + exe + " engines --json").c_str(), "r");
     ASSERT_NE(p, nullptr);
     std::string text;
     char buf[4096];
@@ -155,7 +155,7 @@ TEST(PluginCli, BundledPluginsLoadWithoutTheOption) {
     ASSERT_EQ(::pclose(p), 0) << text;
     EXPECT_EQ(nlohmann::json::parse(text).back()["name"], "ballistic") << layout;
     // And its [gate.ballistic] tables are then known to `check`.
-    EXPECT_EQ(std::system((exe + " check " + kScenarios + " > /dev/null").c_str()), 0) << layout;
+    EXPECT_EQ(std::system(("env -u PHYSVAL_BUNDLED_PLUGIN_DIR " + exe + " check " + kScenarios + " > /dev/null").c_str()), 0) << layout;
   }
 }
 
