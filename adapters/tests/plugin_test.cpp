@@ -259,6 +259,16 @@ TEST(PluginCli, LimitsAndABrokenGuaranteeReachTheResults) {
   EXPECT_EQ(run["limits_hit"], nlohmann::json({"speed clamp: a body was held at 100 m/s"}));
 }
 
+TEST(PluginCli, AContactWithAnObjectThatDoesNotExistIsThePluginsError) {
+  int status = 0;
+  const auto run = misbehaving_run("liar", "", status);
+  EXPECT_EQ(status, 1);
+  EXPECT_EQ(run["status"], "error");
+  EXPECT_NE(run["reason"].get<std::string>().find("plugin liar: a contact names wall 99, but there are 0"),
+            std::string::npos)
+      << run.dump();
+}
+
 TEST(PluginCli, SweepRunsAPlugin) {
   const fs::path out = temp_dir("sweep");
   const auto r = pv("sweep " + kScenarios + "/projectile.toml --plugin " + lib("ballistic") +
