@@ -213,6 +213,7 @@ class EventLoop {
   // Body i's path changed at time t: register its new path and find its next events.
   void reschedule(std::uint32_t i, double t) {
     if (!w_.alive(i)) return;
+    start_substep(w_, i, t, T_);
     // Others find i through its registered box (grown to cover the new path); i's own
     // new events can only be with bodies whose registered boxes meet its new path.
     const Aabb box = path_box(w_, i, t, T_);
@@ -233,6 +234,8 @@ class EventLoop {
       if (aj) reschedule(j, t);
       return;
     }
+    start_substep(w_, i, t, T_);
+    start_substep(w_, j, t, T_);
     const Aabb box_i = path_box(w_, i, t, T_), box_j = path_box(w_, j, t, T_);
     w_.bp->grow(i, box_i);
     w_.bp->grow(j, box_j);
@@ -320,10 +323,17 @@ class EventLoop {
   }
 
   void process_pair(std::uint32_t i, std::uint32_t j, double t, double t_abs) {
-    w_.advance(i, t);
-    w_.advance(j, t);
-    ++w_.stats.impacts;
     const PairResponse& r = w_.response(w_.group[i], w_.group[j]);
+    if (r.collide) {   // on the integrator's own path, which ends a sub-step (substeps.cpp)
+      t = refine_pair_impact(w_, i, j, t, std::max(w_.tloc[i], w_.tloc[j]), T_);
+      t_abs = ctx_.t0 + t;
+      end_substep(w_, i, t);
+      end_substep(w_, j, t);
+    } else {
+      w_.advance(i, t);
+      w_.advance(j, t);
+    }
+    ++w_.stats.impacts;
     if (!r.collide) {   // "event": pass through, report once
       if (r.event) record_contact(w_, i, j, nullptr, t_abs, ctx_.dt);
       add_passing(w_, pair_key(i, j));
@@ -395,10 +405,16 @@ class EventLoop {
   }
 
   void process_static(std::uint32_t i, std::uint32_t k, std::uint8_t feature, double t, double t_abs) {
-    w_.advance(i, t);
-    ++w_.stats.impacts;
     const Segment& seg = w_.statics.segments[k];
     const PairResponse& r = w_.response(w_.group[i], seg.group);
+    if (r.collide) {   // on the integrator's own path, which ends a sub-step (substeps.cpp)
+      t = refine_static_impact(w_, i, seg, feature != 0, t, w_.tloc[i], T_);
+      t_abs = ctx_.t0 + t;
+      end_substep(w_, i, t);
+    } else {
+      w_.advance(i, t);
+    }
+    ++w_.stats.impacts;
     if (!r.collide) {
       if (r.event) record_contact(w_, i, kNone, &seg, t_abs, ctx_.dt);
       add_passing(w_, static_key(i, k));

@@ -11,8 +11,13 @@
 //                         end correction dt/6 (k4 - k1) to reach RK4's velocity
 //
 // Without collisions each reproduces its textbook scheme exactly; an impact changes
-// the velocity at its time and the path continues from there. A body resting on a
-// support moves with its constrained acceleration whatever the integrator.
+// the velocity at its time and the path continues from there. With forces that depend
+// on the velocity, an impact under velocity Verlet or RK4 instead cuts the step into
+// sub-steps, each one step of the scheme (substeps.cpp), so the scheme keeps its order.
+// A body resting on a support moves with its constrained acceleration whatever the
+// integrator.
+#include <algorithm>
+
 #include "world.hpp"
 
 namespace physval::core_detail {
@@ -71,6 +76,13 @@ void begin_paths(World& w, const StepContext& ctx) {
   if (!w.any_forces) return;   // every path is a straight line
   const std::size_t n = w.size();
   const double dt = ctx.dt;
+  if (w.varying_forces) {
+    // Each body's first sub-step is the whole step (substeps.cpp: impacts cut it).
+    std::fill(w.tsub.begin(), w.tsub.end(), 0.0);
+    std::copy(w.pos.begin(), w.pos.end(), w.psub.begin());
+    std::copy(w.vel.begin(), w.vel.end(), w.vsub.begin());
+    std::copy(w.acc.begin(), w.acc.end(), w.ksub.begin());
+  }
   switch (w.integrator) {
     case Integrator::ExplicitEuler:
       for (std::uint32_t i = 0; i < n; ++i) {
@@ -122,7 +134,8 @@ void end_paths(World& w, const StepContext& ctx) {
           a1.resize(n);
           compute_accelerations(w, w.pos, w.vel, a1);
           for (std::uint32_t i = 0; i < n; ++i) {
-            if (free_dynamic(w, i)) w.vel[i] += (0.5 * T) * (a1[i] - w.apath[i]);
+            // Over the body's last sub-step (the whole step unless an impact cut it).
+            if (free_dynamic(w, i)) w.vel[i] += (0.5 * (T - w.tsub[i])) * (a1[i] - w.apath[i]);
           }
         }
         break;
