@@ -292,20 +292,25 @@ class EventLoop {
     switch (e.kind()) {
       case EventKind::Pair: process_pair(e.a, e.b, e.time, t_abs); break;
       case EventKind::Static: process_static(e.a, e.b, e.feature(), e.time, t_abs); break;
-      case EventKind::Stop:
-        w_.advance(e.a, e.time);
+      case EventKind::Stop: {
+        // On the integrator's own path, which ends a sub-step (substeps.cpp).
+        const double t = refine_stop(w_, e.a, e.time, w_.tloc[e.a], T_);
+        end_substep(w_, e.a, t);
         w_.vel[e.a] = {};
         support_path(w_, e.a);
         ++w_.version[e.a];
-        reschedule(e.a, e.time);
+        reschedule(e.a, t);
         break;
-      case EventKind::Leave:
-        w_.advance(e.a, e.time);
+      }
+      case EventKind::Leave: {
+        const double t = refine_leave(w_, e.a, e.time, w_.tloc[e.a], T_);
+        end_substep(w_, e.a, t);
         release_support(w_, e.a);
         ++w_.version[e.a];
-        reschedule(e.a, e.time);
-        free_dependents(e.a, e.time);
+        reschedule(e.a, t);
+        free_dependents(e.a, t);
         break;
+      }
       case EventKind::Expire:
         w_.advance(e.a, e.time);
         kill_body(w_, e.a);

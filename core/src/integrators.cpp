@@ -111,6 +111,10 @@ void begin_paths(World& w, const StepContext& ctx) {
       }
       break;
   }
+  // A body sliding on a face under drag: its support's law integrated by the scheme too.
+  for (std::uint32_t i = 0; w.varying_forces && i < n; ++i) {
+    if (w.supported(i) && uses_substeps(w, i)) start_substep(w, i, 0.0, dt);
+  }
 }
 
 void end_paths(World& w, const StepContext& ctx) {
@@ -135,14 +139,18 @@ void end_paths(World& w, const StepContext& ctx) {
           compute_accelerations(w, w.pos, w.vel, a1);
           for (std::uint32_t i = 0; i < n; ++i) {
             // Over the body's last sub-step (the whole step unless an impact cut it).
-            if (free_dynamic(w, i)) w.vel[i] += (0.5 * (T - w.tsub[i])) * (a1[i] - w.apath[i]);
+            if (free_dynamic(w, i)) {
+              w.vel[i] += (0.5 * (T - w.tsub[i])) * (a1[i] - w.apath[i]);
+            } else if (uses_substeps(w, i)) {   // sliding on a face
+              w.vel[i] += (0.5 * (T - w.tsub[i])) * (substep_acceleration(w, i, w.vel[i]) - w.apath[i]);
+            }
           }
         }
         break;
       case Integrator::Rk4:
         if (w.varying_forces) {
           for (std::uint32_t i = 0; i < n; ++i) {
-            if (free_dynamic(w, i)) w.vel[i] += w.vcorr[i];
+            if (free_dynamic(w, i) || uses_substeps(w, i)) w.vel[i] += w.vcorr[i];
           }
         }
         break;

@@ -40,16 +40,18 @@ namespace {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
+bool on_face(const World& w, std::uint32_t i) { return w.supported(i) && !w.on_body(i); }
+
 // RK4 from (x_s, v_s) with k1 over step h; forces depend on the velocity only (no
 // Newtonian gravity on sub-steps). With want_velocity false k4 is skipped.
 PathState rk4_state(const World& w, std::uint32_t i, double h, bool want_velocity) {
   const Vec2 x = w.psub[i], v = w.vsub[i], k1 = w.ksub[i];
-  const Vec2 k2 = body_acceleration(w, i, v + (0.5 * h) * k1);
-  const Vec2 k3 = body_acceleration(w, i, v + (0.5 * h) * k2);
+  const Vec2 k2 = substep_acceleration(w, i, v + (0.5 * h) * k1);
+  const Vec2 k3 = substep_acceleration(w, i, v + (0.5 * h) * k2);
   PathState s;
   s.p = x + h * v + (h * h / 6.0) * (k1 + k2 + k3);
   if (want_velocity) {
-    const Vec2 k4 = body_acceleration(w, i, v + h * k3);
+    const Vec2 k4 = substep_acceleration(w, i, v + h * k3);
     s.v = v + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
   }
   return s;
@@ -119,8 +121,16 @@ double root_near(F&& f, double t0, double lo, double hi) {
 }  // namespace
 
 bool uses_substeps(const World& w, std::uint32_t i) {
-  return w.varying_forces && !w.newtonian && w.dynamic(i) && !w.supported(i) &&
+  return w.varying_forces && !w.newtonian && w.dynamic(i) && (!w.supported(i) || on_face(w, i)) &&
          (w.integrator == Integrator::VelocityVerlet || w.integrator == Integrator::Rk4);
+}
+
+Vec2 substep_acceleration(const World& w, std::uint32_t i, Vec2 v) {
+  const Vec2 a = body_acceleration(w, i, v);
+  if (!w.supported(i)) return a;
+  // Friction keeps the direction it had at the sub-step's start: a body does not turn
+  // back without a stop event, so the law is smooth on every sub-step.
+  return support_acceleration(w, i, a, dot(w.vsub[i], perp(w.support_n[i])));
 }
 
 bool needs_impact_refinement(const World& w, std::uint32_t i) {
@@ -136,7 +146,7 @@ PathState integrator_state(const World& w, std::uint32_t i, double t) {
   const Vec2 v_pred = w.vsub[i] + h * k1;
   PathState s;
   s.p = w.psub[i] + h * w.vsub[i] + (0.5 * h * h) * k1;
-  s.v = v_pred + (0.5 * h) * (body_acceleration(w, i, v_pred) - k1);
+  s.v = v_pred + (0.5 * h) * (substep_acceleration(w, i, v_pred) - k1);
   return s;
 }
 
@@ -155,19 +165,19 @@ void start_substep(World& w, std::uint32_t i, double t, double T) {
   if (!w.alive(i) || !uses_substeps(w, i)) return;
   w.advance(i, t);
   const double h = T - t;
-  const Vec2 x = w.pos[i], v = w.vel[i];
-  const Vec2 k1 = body_acceleration(w, i, v);
   w.tsub[i] = t;
-  w.psub[i] = x;
-  w.vsub[i] = v;
+  w.psub[i] = w.pos[i];
+  w.vsub[i] = w.vel[i];
+  const Vec2 v = w.vel[i];
+  const Vec2 k1 = substep_acceleration(w, i, v);
   w.ksub[i] = k1;
   if (w.integrator == Integrator::VelocityVerlet) {
     w.apath[i] = k1;   // end_paths adds 1/2 (T - t) (a(end) - k1)
     return;
   }
-  const Vec2 k2 = body_acceleration(w, i, v + (0.5 * h) * k1);
-  const Vec2 k3 = body_acceleration(w, i, v + (0.5 * h) * k2);
-  const Vec2 k4 = body_acceleration(w, i, v + h * k3);
+  const Vec2 k2 = substep_acceleration(w, i, v + (0.5 * h) * k1);
+  const Vec2 k3 = substep_acceleration(w, i, v + (0.5 * h) * k2);
+  const Vec2 k4 = substep_acceleration(w, i, v + h * k3);
   w.apath[i] = (1.0 / 3.0) * (k1 + k2 + k3);
   w.vcorr[i] = (h / 6.0) * (k4 - k1);
 }
@@ -193,6 +203,26 @@ double refine_pair_impact(const World& w, std::uint32_t i, std::uint32_t j, doub
   const double R = w.radius[i] + w.radius[j];
   return root_near([&](double s) { return length(position_on_path(w, j, s) - position_on_path(w, i, s)) - R; }, t,
                    t_min, T);
+}
+
+double refine_stop(const World& w, std::uint32_t i, double t, double t_min, double T) {
+  if (!uses_substeps(w, i) || !on_face(w, i)) return t;
+  const Vec2 tang = perp(w.support_n[i]);
+  const double dir = dot(w.vsub[i], tang) > 0.0 ? 1.0 : -1.0;
+  return root_near([&](double s) { return dir * dot(integrator_state(w, i, s).v, tang); }, t, t_min, T);
+}
+
+double refine_leave(const World& w, std::uint32_t i, double t, double t_min, double T) {
+  if (!needs_impact_refinement(w, i) || !on_face(w, i)) return t;
+  const Segment& seg = w.statics.segments[w.support[i]];
+  // Off the end it is heading for: u < 0 at `from`, u > L at `to`.
+  const bool at_from = dot(w.pos_at(i, t) - seg.from, seg.dir) < 0.5 * seg.length;
+  return root_near(
+      [&](double s) {
+        const double u = dot(position_on_path(w, i, s) - seg.from, seg.dir);
+        return at_from ? u : seg.length - u;
+      },
+      t, t_min, T);
 }
 
 }  // namespace physval::core_detail

@@ -298,6 +298,10 @@ void record_emission(World& w, std::uint32_t emitter, Vec2 position, Vec2 veloci
 // Path acceleration of a supported body: the normal component removed and Coulomb
 // friction (or rolling resistance) along the support (resting_contact.cpp).
 void support_path(World& w, std::uint32_t i);
+// The support's law for body i on its segment: the acceleration along the face under
+// the force acceleration a (its normal part taken by the support), with kinetic
+// friction against the sign of vt, or at vt == 0 held by static friction up to its limit.
+Vec2 support_acceleration(const World& w, std::uint32_t i, Vec2 a, double vt);
 // Releases body i from its support.
 void release_support(World& w, std::uint32_t i);
 // Body i comes to rest on body j (stuck there), along n from j to i.
@@ -313,9 +317,13 @@ double support_stop_time(const World& w, std::uint32_t i, double t, double T);
 double support_leave_time(const World& w, std::uint32_t i, double t, double T);
 
 // Sub-steps (substeps.cpp): an impact inside a step keeps the integrator's order.
-// Whether body i's velocity change inside a step starts a new sub-step of its
-// integrator (state-dependent forces, velocity Verlet or RK4, free, no Newtonian gravity).
+// Whether body i follows sub-steps of its integrator, so that a velocity change inside
+// a step starts a new one: state-dependent forces, velocity Verlet or RK4, no Newtonian
+// gravity, free or sliding on a face (not at rest on bodies).
 bool uses_substeps(const World& w, std::uint32_t i);
+// The acceleration of body i on sub-steps at velocity v: its forces', or on a face the
+// support's law with friction against the sliding direction of the sub-step's start.
+Vec2 substep_acceleration(const World& w, std::uint32_t i, Vec2 v);
 // Body i's state at time t of the step as its integrator gives it: one step of the
 // integrator from the start of its current sub-step to t. Off sub-steps: its path.
 struct PathState {
@@ -334,6 +342,10 @@ void start_substep(World& w, std::uint32_t i, double t, double T);
 double refine_static_impact(const World& w, std::uint32_t i, const Segment& seg, bool cap, double t, double t_min,
                             double T);
 double refine_pair_impact(const World& w, std::uint32_t i, std::uint32_t j, double t, double t_min, double T);
+// The same for a sliding body's stop (its velocity along the face reaches 0) and for
+// its leaving the end of its segment.
+double refine_stop(const World& w, std::uint32_t i, double t, double t_min, double T);
+double refine_leave(const World& w, std::uint32_t i, double t, double t_min, double T);
 
 // Box bounding body i's path from t to T (swept), plus its radius.
 Aabb path_box(const World& w, std::uint32_t i, double t, double T);

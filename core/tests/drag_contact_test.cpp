@@ -323,3 +323,98 @@ TEST(CoreDragContact, WithoutDragStillExact) {
 }
 
 }  // namespace physval::test
+
+namespace physval::test {
+
+// Sliding under drag is drag plus contact too: the support's law (friction against the
+// sliding direction) is integrated by the scheme, and the stop is found on its path.
+// Linear drag, no wind: the ball lands with e = 0 and slides with kinetic friction
+// mu g; along the floor v' = -v / tau - mu g, so v(s) = v_b + (v_l - v_b) e^{-s/tau}
+// with v_b = -tau mu g and v_l the landing's velocity less friction's impulse mu |v_n|,
+// and it stops at s* = tau ln((v_l - v_b) / -v_b), at rest for good (no force pushes
+// it once still).
+TEST(CoreDragContact, SlidingUnderLinearDragStopsWhereTheClosedFormSays) {
+  for (double mu : {0.1, 0.4}) {
+    for (double k : {0.2, 0.8}) {
+      SCOPED_TRACE("mu " + std::to_string(mu) + " k " + std::to_string(k));
+      const double m = 1.0, tau = m / k, r = 0.2;
+      BodyDef b = circle("ball", {0.0, 1.0}, {7.0, 3.0}, r, m, 0.0);
+      b.drag_linear = k;
+      b.friction = mu;
+      const Scene s = scene_of({b}, {wall("floor", {-30.0, 0.0}, {60.0, 0.0}, 0.0, mu)}, {0.0, -g});
+      // Flight: closed form to the landing (y = r), then the slide.
+      ClosedForm cf;
+      cf.tau = tau;
+      cf.v_inf = {0.0, -tau * g};
+      const Vec2 x0{0.0, 1.0}, v0{7.0, 3.0};
+      const double t_land = first_root([&](double t) { return cf.pos(x0, v0, t).y - r; }, 10.0);
+      ASSERT_GT(t_land, 0.0);
+      // The landing takes the normal velocity, and friction's impulse mu |v_n| with it.
+      const double x_land = cf.pos(x0, v0, t_land).x;
+      const double v_land = cf.vel(v0, t_land).x - mu * std::fabs(cf.vel(v0, t_land).y);
+      const double vb = -tau * mu * g;
+      const double s_stop = tau * std::log((v_land - vb) / -vb);
+      const double x_stop = x_land + vb * s_stop + tau * (v_land - vb) * -std::expm1(-s_stop / tau);
+      const double t_mid = t_land + 0.5 * s_stop;   // sliding, halfway to the stop
+      const double x_mid = x_land + vb * (0.5 * s_stop) + tau * (v_land - vb) * -std::expm1(-0.5 * s_stop / tau);
+      const double v_mid = vb + (v_land - vb) * std::exp(-0.5 * s_stop / tau);
+      for (const char* integ : {"rk4", "velocity_verlet"}) {
+        SCOPED_TRACE(integ);
+        const bool rk4 = std::string(integ) == "rk4";
+        std::vector<double> err_mid;
+        for (int level = 0; level < 3; ++level) {
+          const double dt = (rk4 ? 1.0 / 20.0 : 1.0 / 240.0) / (1 << level);
+          Sim sim(s, options(integ));
+          sim.run_until(t_mid, dt);
+          err_mid.push_back(std::hypot(sim.state(0).position.x - x_mid, sim.state(0).velocity.x - v_mid));
+          EXPECT_NEAR(sim.state(0).position.y, r, 1e-12);   // on the floor
+          sim.run_until(t_land + s_stop + 0.5, dt);
+          ASSERT_EQ(sim.contacts.size(), 1u);
+          EXPECT_NEAR(sim.contacts[0].time, t_land, rk4 ? 1e-6 : 1e-5);
+          EXPECT_EQ(sim.state(0).velocity.x, 0.0);   // stopped, and stays
+          EXPECT_NEAR(sim.state(0).position.x, x_stop, rk4 ? 1e-6 : 1e-4);
+        }
+        // The error while sliding shrinks at the scheme's order.
+        const double p = rk4 ? 16.0 : 4.0;
+        for (int level = 1; level < 3; ++level) {
+          EXPECT_GT(err_mid[level - 1] / err_mid[level], 0.75 * p) << err_mid[level - 1] << " -> " << err_mid[level];
+          EXPECT_LT(err_mid[level - 1] / err_mid[level], 1.25 * p) << err_mid[level - 1] << " -> " << err_mid[level];
+        }
+      }
+    }
+  }
+}
+
+// The same slide with quadratic drag, a wind and friction: the observed order from
+// successive differences (no closed form), through the landing, the slide and the stop.
+TEST(CoreDragContact, SlidingUnderQuadraticDragConvergesAtTheIntegratorsOrder) {
+  for (double mu : {0.0, 0.3}) {
+    SCOPED_TRACE(mu);
+    BodyDef b = circle("ball", {0.0, 1.0}, {8.0, 2.0}, 0.2, 1.0, 0.0);
+    b.drag_linear = 0.3;
+    b.drag_quadratic = 0.02;
+    b.friction = mu;
+    Scene s = scene_of({b}, {wall("floor", {-30.0, 0.0}, {60.0, 0.0}, 0.0, mu)}, {0.0, -g});
+    s.world.wind = {-1.0, 0.5};
+    for (const char* integ : {"rk4", "velocity_verlet"}) {
+      SCOPED_TRACE(integ);
+      const bool rk4 = std::string(integ) == "rk4";
+      std::vector<Vec2> end;
+      for (int level = 0; level < 4; ++level) {
+        const double dt = (rk4 ? 1.0 / 30.0 : 1.0 / 120.0) / (1 << level);
+        Sim sim(s, options(integ));
+        for (long n = std::lround(2.4 / dt); n > 0; --n) sim.step(dt);
+        EXPECT_EQ(sim.contacts.size(), 1u);
+        end.push_back(sim.state(0).position);
+      }
+      const double p = rk4 ? 16.0 : 4.0;
+      for (int level = 0; level + 2 < 4; ++level) {
+        const double d1 = length(end[level] - end[level + 1]), d2 = length(end[level + 1] - end[level + 2]);
+        EXPECT_GT(d1 / d2, 0.75 * p) << d1 << " -> " << d2;
+        EXPECT_LT(d1 / d2, 1.25 * p) << d1 << " -> " << d2;
+      }
+    }
+  }
+}
+
+}  // namespace physval::test
