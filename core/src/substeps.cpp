@@ -21,10 +21,13 @@
 //   3. the impulse is applied;
 //   4. a new sub-step of length T - t starts from the new state: its path and end
 //      correction are the integrator's for that step.
+// A body sliding on a face follows the same rule with the support's law in the
+// stages (friction against the sliding direction of the sub-step's start, so the law
+// is smooth on it); its stop and its leaving the face's end are found on Phi too.
 // Every piece is then one step of the integrator between events, so the error after
 // any number of impacts shrinks at the integrator's order. The cost: per impact of a
 // body with such forces, 4 acceleration evaluations for the new sub-step, and for
-// RK4 about 3 per gap evaluation of the refinement (typically 10 to 30 of them).
+// RK4 2 per gap evaluation of the refinement (typically 15 to 25 of them).
 // Explicit and semi-implicit Euler are first order with or without an impact inside
 // a step and keep their lecture paths. Newtonian gravity couples every body's path, so
 // its scenes keep one sub-step per step (an impact there costs RK4 its order).
