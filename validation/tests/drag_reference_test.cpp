@@ -40,7 +40,8 @@ TEST(DragReference, BuiltinDragBallSceneHasAConvergedReference) {
 }
 
 // The same throw with quadratic drag (no closed form), winds, restitution 1 and < 1,
-// and another angle: the reference converges every time.
+// other angles, and one that bounces to rest and slides to a stop: the reference
+// converges every time.
 TEST(DragReference, DragAndContactVariantsConverge) {
   const Scene base = load_builtin("models/drag_ball_wall_floor.toml");
   struct Variant {
@@ -48,12 +49,17 @@ TEST(DragReference, DragAndContactVariantsConverge) {
     Vec2 wind;
     double e;
     Vec2 v0;
+    double mu = 0.0;
+    double duration = 3.0;
   };
   const Variant variants[] = {
       {0.0, 0.02, {0.0, 0.0}, 1.0, {12.0, 7.0}},
       {0.0, 0.05, {-3.0, 0.0}, 0.8, {12.0, 7.0}},
       {0.3, 0.01, {2.0, -1.0}, 0.6, {10.0, 9.0}},
       {0.12, 0.0, {-3.0, 0.0}, 1.0, {14.0, 3.0}},
+      // Bounces to rest on the floor (micro-bounces, then resting contact), slides with
+      // friction against the headwind's drag and stops.
+      {0.12, 0.02, {-3.0, 0.0}, 0.5, {12.0, 7.0}, 0.2, 6.0},
   };
   for (const Variant& v : variants) {
     SCOPED_TRACE("k1 " + std::to_string(v.k1) + " k2 " + std::to_string(v.k2) + " e " + std::to_string(v.e));
@@ -65,7 +71,14 @@ TEST(DragReference, DragAndContactVariantsConverge) {
     s.bodies[0].drag_quadratic = v.k2;
     s.bodies[0].velocity = v.v0;
     s.bodies[0].restitution = v.e;
-    for (WallDef& w : s.walls) w.material.restitution = v.e;
+    s.bodies[0].friction = v.mu;
+    s.bodies[0].static_friction = v.mu;
+    s.duration = v.duration;
+    for (WallDef& w : s.walls) {
+      w.material.restitution = v.e;
+      w.material.friction = v.mu;
+      w.material.static_friction = v.mu;
+    }
     const Reference ref = make_reference(s, RunOptions{});
     ASSERT_TRUE(ref.available) << ref.reason;
     EXPECT_TRUE(ref.converged) << ref.reason;
