@@ -27,7 +27,7 @@
 // Every piece is then one step of the integrator between events, so the error after
 // any number of impacts shrinks at the integrator's order. The cost: per impact of a
 // body with such forces, 4 acceleration evaluations for the new sub-step, and for
-// RK4 2 per gap evaluation of the refinement (typically 15 to 25 of them).
+// RK4 2 per gap evaluation of the refinement (typically 7 of them).
 // Explicit and semi-implicit Euler are first order with or without an impact inside
 // a step and keep their lecture paths. Newtonian gravity couples every body's path, so
 // its scenes keep one sub-step per step (an impact there costs RK4 its order).
@@ -86,10 +86,17 @@ double root_near(F&& f, double t0, double lo, double hi) {
       fb = fn;
       break;
     }
+    if (tn == limit) return t0;
+    // The next stride at least doubles, and reaches past where the secant through the
+    // last two samples puts the root (usually bracketing it at the next sample).
+    double next = 2.0 * stride;
+    if (fn != fa) {
+      const double dist = dir * (tn - fn * (tn - a) / (fn - fa) - t0);
+      if (std::isfinite(dist)) next = std::max(next, 1.25 * dist);
+    }
     a = tn;
     fa = fn;
-    if (tn == limit) return t0;
-    stride *= 2.0;
+    stride = next;
   }
   if ((fb > 0.0) == (f0 > 0.0)) return t0;
   // Orient: p on the f > 0 side, q on the f <= 0 side.
