@@ -27,7 +27,7 @@
 // Every piece is then one step of the integrator between events, so the error after
 // any number of impacts shrinks at the integrator's order. The cost: per impact of a
 // body with such forces, 4 acceleration evaluations for the new sub-step, and for
-// RK4 2 per gap evaluation of the refinement (typically 7 of them).
+// RK4 2 per gap evaluation of the refinement (typically 4 of them).
 // Explicit and semi-implicit Euler are first order with or without an impact inside
 // a step and keep their lecture paths. Newtonian gravity couples every body's path, so
 // its scenes keep one sub-step per step (an impact there costs RK4 its order).
@@ -42,6 +42,11 @@ namespace physval::core_detail {
 namespace {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
+// A gap (or a velocity) within this many ulps of its scale is zero: the round-off of
+// evaluating it on the path, far below anything the scheme resolves.
+constexpr double kTolUlps = 4.0;
+
+double inf_norm(Vec2 v) { return std::max(std::fabs(v.x), std::fabs(v.y)); }
 
 bool on_face(const World& w, std::uint32_t i) { return w.supported(i) && !w.on_body(i); }
 
@@ -66,13 +71,14 @@ Vec2 position_on_path(const World& w, std::uint32_t i, double t) {
 }
 
 // A root of f near t0 in [lo, hi]: searched outward from t0 (later if f(t0) > 0, else
-// earlier) with doubling strides, then closed by a bracketed secant (Illinois) with
-// bisection when it crawls. Returns the bracket's end with f <= 0 (contact reached);
-// t0 when no sign change is found (a graze the two paths see differently).
+// earlier) with growing strides, then closed by a bracketed secant (Illinois) with
+// bisection when it crawls. Returns a point where |f| <= ftol (f's round-off), else
+// the bracket's end with f <= 0 (contact reached); t0 when no sign change is found (a
+// graze the two paths see differently).
 template <class F>
-double root_near(F&& f, double t0, double lo, double hi) {
+double root_near(F&& f, double t0, double lo, double hi, double ftol) {
   const double f0 = f(t0);
-  if (f0 == 0.0 || !(hi > lo)) return t0;
+  if (std::fabs(f0) <= ftol || !(hi > lo)) return t0;
   const double dir = f0 > 0.0 ? 1.0 : -1.0;
   const double limit = dir > 0.0 ? hi : lo;
   double stride = std::max(std::ldexp(hi - lo, -34), 4.0 * kEps * std::max(std::fabs(t0), hi - lo));
@@ -113,6 +119,7 @@ double root_near(F&& f, double t0, double lo, double hi) {
     if (!(std::min(p, q) < s && s < std::max(p, q))) s = mid;
     if (it % 8 == 7) s = mid;   // a guaranteed halving now and then
     const double fs = f(s);
+    if (std::fabs(fs) <= ftol) return s;
     if (fs > 0.0) {
       p = s;
       fp = fs;
@@ -196,43 +203,48 @@ double refine_static_impact(const World& w, std::uint32_t i, const Segment& seg,
                             double T) {
   if (!needs_impact_refinement(w, i)) return t;
   const double r = w.radius[i];
+  const Vec2 pt = w.pos_at(i, t);
+  const double ftol = kTolUlps * kEps * (inf_norm(pt) + r);
   if (cap) {
-    const Vec2 pt = w.pos_at(i, t);
     const Vec2 q = length_squared(pt - seg.from) <= length_squared(pt - seg.to) ? seg.from : seg.to;
-    return root_near([&](double s) { return length(position_on_path(w, i, s) - q) - r; }, t, t_min, T);
+    return root_near([&](double s) { return length(position_on_path(w, i, s) - q) - r; }, t, t_min, T, ftol);
   }
   // The side the body is on before the impact (a point on the line: the side it moves from).
   const double D = dot(w.pos[i] - seg.from, seg.normal);
   const double side = D > 0.0 ? 1.0 : D < 0.0 ? -1.0 : (dot(w.vel[i], seg.normal) < 0.0 ? 1.0 : -1.0);
   return root_near([&](double s) { return side * dot(position_on_path(w, i, s) - seg.from, seg.normal) - r; }, t,
-                   t_min, T);
+                   t_min, T, ftol);
 }
 
 double refine_pair_impact(const World& w, std::uint32_t i, std::uint32_t j, double t, double t_min, double T) {
   if (!needs_impact_refinement(w, i) && !needs_impact_refinement(w, j)) return t;
   const double R = w.radius[i] + w.radius[j];
+  const double ftol = kTolUlps * kEps * (inf_norm(w.pos_at(i, t)) + inf_norm(w.pos_at(j, t)) + R);
   return root_near([&](double s) { return length(position_on_path(w, j, s) - position_on_path(w, i, s)) - R; }, t,
-                   t_min, T);
+                   t_min, T, ftol);
 }
 
 double refine_stop(const World& w, std::uint32_t i, double t, double t_min, double T) {
   if (!uses_substeps(w, i) || !on_face(w, i)) return t;
   const Vec2 tang = perp(w.support_n[i]);
   const double dir = dot(w.vsub[i], tang) > 0.0 ? 1.0 : -1.0;
-  return root_near([&](double s) { return dir * dot(integrator_state(w, i, s).v, tang); }, t, t_min, T);
+  const double ftol = kTolUlps * kEps * inf_norm(w.vsub[i]);
+  return root_near([&](double s) { return dir * dot(integrator_state(w, i, s).v, tang); }, t, t_min, T, ftol);
 }
 
 double refine_leave(const World& w, std::uint32_t i, double t, double t_min, double T) {
   if (!needs_impact_refinement(w, i) || !on_face(w, i)) return t;
   const Segment& seg = w.statics.segments[w.support[i]];
   // Off the end it is heading for: u < 0 at `from`, u > L at `to`.
-  const bool at_from = dot(w.pos_at(i, t) - seg.from, seg.dir) < 0.5 * seg.length;
+  const Vec2 pt = w.pos_at(i, t);
+  const bool at_from = dot(pt - seg.from, seg.dir) < 0.5 * seg.length;
+  const double ftol = kTolUlps * kEps * inf_norm(pt);
   return root_near(
       [&](double s) {
         const double u = dot(position_on_path(w, i, s) - seg.from, seg.dir);
         return at_from ? u : seg.length - u;
       },
-      t, t_min, T);
+      t, t_min, T, ftol);
 }
 
 }  // namespace physval::core_detail
