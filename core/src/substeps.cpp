@@ -227,7 +227,10 @@ double refine_pair_impact(const World& w, std::uint32_t i, std::uint32_t j, doub
 double refine_stop(const World& w, std::uint32_t i, double t, double t_min, double T) {
   if (!uses_substeps(w, i) || !on_face(w, i)) return t;
   const Vec2 tang = perp(w.support_n[i]);
-  const double dir = dot(w.vsub[i], tang) > 0.0 ? 1.0 : -1.0;
+  // The direction it slides in: its velocity's (at its last event), or from rest the
+  // direction its acceleration took it.
+  const double vt = dot(w.vel[i], tang);
+  const double dir = (vt != 0.0 ? vt : dot(w.apath[i], tang)) > 0.0 ? 1.0 : -1.0;
   const double ftol = kTolUlps * kEps * inf_norm(w.vsub[i]);
   return root_near([&](double s) { return dir * dot(integrator_state(w, i, s).v, tang); }, t, t_min, T, ftol);
 }

@@ -418,3 +418,45 @@ TEST(CoreDragContact, SlidingUnderQuadraticDragConvergesAtTheIntegratorsOrder) {
 }
 
 }  // namespace physval::test
+
+namespace physval::test {
+
+// A ball at rest on the floor from t = 0, pushed by a wind through linear drag harder
+// than static friction holds: it slides with v(t) = v_inf (1 - e^{-t/tau}),
+// v_inf = w - tau mu_k g, x(t) = v_inf (t - tau (1 - e^{-t/tau})). RK4 follows it at
+// fourth order from the first step (sub-steps on a face from the start).
+TEST(CoreDragContact, WindPushesARestingBallAlongTheFloor) {
+  const double m = 0.5, k = 0.4, wind = 6.0, mu = 0.2, r = 0.1;
+  const double tau = m / k, v_inf = wind - tau * mu * g;
+  ASSERT_GT(k * wind / m, mu * g);   // static friction (mu_s = mu) cannot hold it
+  BodyDef b = circle("ball", {0.0, r}, {}, r, m, 0.0);
+  b.drag_linear = k;
+  b.friction = mu;
+  Scene s = scene_of({b}, {wall("floor", {-10.0, 0.0}, {100.0, 0.0}, 0.0, mu)}, {0.0, -g});
+  s.world.wind = {wind, 0.0};
+  const double T = 3.0;
+  const double x_exact = v_inf * (T - tau * -std::expm1(-T / tau));
+  const double v_exact = v_inf * -std::expm1(-T / tau);
+  for (const char* integ : {"rk4", "velocity_verlet"}) {
+    SCOPED_TRACE(integ);
+    const bool rk4 = std::string(integ) == "rk4";
+    std::vector<double> err;
+    for (int level = 0; level < 3; ++level) {
+      const double dt = (rk4 ? 1.0 / 10.0 : 1.0 / 60.0) / (1 << level);
+      Sim sim(s, options(integ));
+      for (long n = std::lround(T / dt); n > 0; --n) sim.step(dt);
+      const BodyState st = sim.state(0);
+      EXPECT_NEAR(st.position.y, r, 1e-12);
+      EXPECT_EQ(st.velocity.y, 0.0);
+      EXPECT_NEAR(st.position.x, x_exact, rk4 ? 1e-6 : 1e-3);
+      err.push_back(std::hypot(st.position.x - x_exact, st.velocity.x - v_exact));
+    }
+    const double p = rk4 ? 16.0 : 4.0;
+    for (int level = 1; level < 3; ++level) {
+      EXPECT_GT(err[level - 1] / err[level], 0.75 * p) << err[level - 1] << " -> " << err[level];
+      EXPECT_LT(err[level - 1] / err[level], 1.25 * p) << err[level - 1] << " -> " << err[level];
+    }
+  }
+}
+
+}  // namespace physval::test
