@@ -1022,6 +1022,19 @@ Scene read_scene(Context& ctx, const toml::table& root) {
       r.error_at(*n, "sample_interval", "must be >= dt (" + format_number(s.dt) + ") or 0 for automatic, got " +
                                             format_number(s.sample_interval));
     }
+  } else if (s.sample_interval > 0.0 && s.dt > 0.0) {
+    // States are sampled every whole number of steps: 0.15 s at dt = 0.1 s was silently
+    // sampled every 0.1 s. Within 1e-9 of a whole number (round-off of "1/60" and the like).
+    const double steps = s.sample_interval / s.dt;
+    const double whole = std::round(steps);
+    if (std::abs(steps - whole) > 1e-9 * std::max(1.0, steps)) {
+      if (const toml::node* n = root.get("sample_interval")) {
+        const double below = std::max(1.0, std::floor(steps)) * s.dt, above = std::ceil(steps) * s.dt;
+        r.error_at(*n, "sample_interval", "must be a whole number of steps of dt = " + format_number(s.dt) + " (" +
+                                              format_number(below) + " or " + format_number(above) + "), got " +
+                                              format_number(s.sample_interval));
+      }
+    }
   }
   bool allow_initial_overlap = false;
   r.read("allow_initial_overlap", allow_initial_overlap);

@@ -183,3 +183,24 @@ TEST_F(Budget, ABodyInsideAWallAtTheStartIsAnError) {
 }
 
 }  // namespace
+
+namespace {
+
+// sample_interval = 0.15 at dt = 0.1 was sampled every 0.1 s without a word.
+TEST_F(Budget, ASampleIntervalThatIsNotAWholeNumberOfStepsIsAnError) {
+  const std::string head = "name = \"s\"\nduration = 1.0\ndt = 0.1\n";
+  const std::string body = "[[bodies]]\nname = \"a\"\nradius = 0.1\nposition = [0, 0]\n";
+  const fs::path f = write("s.toml", head + "sample_interval = 0.15\n" + body);
+  const Result r = physval("check " + f.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_TRUE(has(r, f.string() + ":4:19: sample_interval: must be a whole number of steps of dt = 0.1 (0.1 or 0.2), got 0.15"))
+      << r.output;
+  // Whole numbers of steps pass, also through round-off ("1/60" steps, 0.3 = 3 x 0.1).
+  EXPECT_EQ(physval("check " + write("a.toml", head + "sample_interval = 0.3\n" + body).string()).status, 0);
+  EXPECT_EQ(physval("check " + write("b.toml", "name = \"b\"\nduration = 1.0\ndt = \"1/60\"\nsample_interval = 0.05\n" + body)
+                                   .string())
+                .status,
+            0);
+}
+
+}  // namespace
