@@ -821,6 +821,29 @@ void check_initial_overlaps(Context& ctx, const toml::table& root, const Scene& 
       break;
     }
   }
+  // A body whose centre is inside a box: a box is a solid obstacle (the lecture's "a point
+  // is inside a box" test; Box2D and Bullet build a solid polygon or box), so a body that
+  // starts inside is pushed out by them and kept in by core's four sides. No run compares.
+  for (std::size_t i = 0; i < s.bodies.size() && reported < 5; ++i) {
+    const BodyDef& d = s.bodies[i];
+    if (d.is_static) continue;
+    for (const BoxDef& b : s.boxes) {
+      const Vec2 x = d.position;
+      if (!(x.x > b.min.x && x.x < b.max.x && x.y > b.min.y && x.y < b.max.y)) continue;
+      if (!response_between(s, d.group, b.material.group).collide) continue;
+      const toml::node* at = array != nullptr && i < array->size() ? array->get(i) : nullptr;
+      if (const auto* t = at != nullptr ? at->as_table() : nullptr; t != nullptr && t->get("position") != nullptr) {
+        at = t->get("position");
+      }
+      ctx.error(at != nullptr ? at->source() : root.source(), indexed("bodies", i) + ".position",
+                "is inside box \"" + b.name +
+                    "\" at t = 0: a box is a solid obstacle (Box2D and Bullet build it solid and push the body "
+                    "out, core's sides keep it in); build a container from four [[walls]] (or set "
+                    "allow_initial_overlap = true at the top level if you mean it)");
+      ++reported;
+      break;
+    }
+  }
 }
 
 Scene read_scene(Context& ctx, const toml::table& root) {
