@@ -6,6 +6,7 @@
 #include "physval/adapters/chipmunk_adapter.hpp"
 
 #include <chipmunk/chipmunk.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -39,13 +40,15 @@ std::string chipmunk_version() {
 
 // The Debian build is a debug build: its first cpSpaceInit prints a banner on stdout,
 // where physval writes its own output. Create (and free) the first space once, with
-// stdout pointed at stderr, before any run needs one.
+// stdout pointed at /dev/null, before any run needs one.
 void silence_banner_once() {
   static std::once_flag once;
   std::call_once(once, [] {
     std::fflush(stdout);
     const int saved = ::dup(STDOUT_FILENO);
-    if (saved >= 0) ::dup2(STDERR_FILENO, STDOUT_FILENO);
+    const int null_fd = ::open("/dev/null", O_WRONLY);
+    if (saved >= 0 && null_fd >= 0) ::dup2(null_fd, STDOUT_FILENO);
+    if (null_fd >= 0) ::close(null_fd);
     cpSpaceFree(cpSpaceNew());
     std::fflush(stdout);
     if (saved >= 0) {
@@ -468,7 +471,7 @@ std::vector<Setting> ChipmunkEngine::settings() const {
       {"version", chipmunk_version()},
       {"runtime_version", cpVersionString},
       {"precision", "float64 (cpFloat = double)"},
-      {"build", "Debian's debug build: runtime assertions on (a failed one aborts), banner sent to stderr"},
+      {"build", "Debian's debug build: runtime assertions on (a failed one aborts); its stdout banner is discarded"},
       {"step", "one cpSpaceStep(dt) per physval step: x += dt (v + v_bias), collide, v += dt (g + F / m), solve"},
       {"integration", "positions advance with the velocity the step starts with (explicit Euler in position): a free "
                       "fall lags the closed form by g dt t / 2"},
