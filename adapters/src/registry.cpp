@@ -1,7 +1,10 @@
 #include "physval/adapters/registry.hpp"
 
+#include <cstdlib>
+
 #include "physval/adapters/box2d_adapter.hpp"
 #include "physval/adapters/bullet_adapter.hpp"
+#include "physval/adapters/plugin_engine.hpp"
 #include "physval/core/core_engine.hpp"
 #ifdef PHYSVAL_HAVE_CHIPMUNK
 #include "physval/adapters/chipmunk_adapter.hpp"
@@ -12,8 +15,10 @@
 
 namespace physval {
 
-const std::vector<EngineFactory>& engine_registry() {
-  static const std::vector<EngineFactory> engines = [] {
+namespace {
+
+std::vector<EngineFactory>& mutable_registry() {
+  static std::vector<EngineFactory> engines = [] {
     std::vector<EngineFactory> all = {core_engine_factory(), box2d_engine_factory(), bullet_engine_factory()};
     // Optional engines, built when their Debian packages are found (adapters/CMakeLists.txt).
 #ifdef PHYSVAL_HAVE_CHIPMUNK
@@ -27,6 +32,29 @@ const std::vector<EngineFactory>& engine_registry() {
     return all;
   }();
   return engines;
+}
+
+}  // namespace
+
+const std::vector<EngineFactory>& engine_registry() { return mutable_registry(); }
+
+void register_engine(EngineFactory factory) {
+  if (const EngineFactory* same = find_engine(factory.info.name)) {
+    throw PluginError("engine \"" + factory.info.name + "\" is already registered (" + same->info.summary +
+                      "): each engine needs a name of its own");
+  }
+  mutable_registry().push_back(std::move(factory));
+}
+
+std::vector<std::string> register_plugins(const std::vector<std::string>& args) {
+  const char* env = std::getenv("PHYSVAL_PLUGIN_PATH");
+  std::vector<std::string> names;
+  for (const std::string& arg : args) {
+    EngineFactory f = load_plugin(resolve_plugin_path(arg, env == nullptr ? "" : env));
+    names.push_back(f.info.name);
+    register_engine(std::move(f));
+  }
+  return names;
 }
 
 const EngineFactory* find_engine(const std::string& name) {

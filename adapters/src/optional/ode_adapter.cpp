@@ -32,6 +32,8 @@ using adapter::SceneObjects;
 constexpr const char* kEngineName = "ode";
 // Half-depth along z of static boxes (spheres stay at z = 0: any positive value works).
 constexpr double kHalfDepthZ = 1.0;
+// max_correcting_velocity at or above this is ODE's own dInfinity.
+constexpr double kUnbounded = 1e30;
 // Contacts dCollide may return for one pair (a sphere makes one with anything).
 constexpr int kMaxContacts = 4;
 
@@ -110,9 +112,9 @@ std::vector<OptionSpec> ode_options() {
        OptionRange::at_least(0)},
       {"contact_surface_layer", 0.0, {},
        "Overlap (m) left uncorrected (dWorldSetContactSurfaceLayer). ODE's default.", OptionRange::at_least(0)},
-      {"max_correcting_velocity", std::numeric_limits<double>::infinity(), {},
-       "Largest velocity (m/s) the overlap correction may give (dWorldSetContactMaxCorrectingVel). ODE's default: "
-       "unbounded.",
+      {"max_correcting_velocity", kUnbounded, {},
+       "Largest velocity (m/s) the overlap correction may give (dWorldSetContactMaxCorrectingVel). 1e30 and above: "
+       "unbounded, ODE's default dInfinity (an option's default must be finite).",
        OptionRange::at_least(0)},
       {"segment_radius", 1e-9, {},
        "Walls and surface segments are capsules of this radius (m), and points spheres of it. ODE's broad phase "
@@ -148,7 +150,7 @@ struct OdeOptions {
   double cfm = 1e-10;
   double restitution_threshold = 0.0;
   double surface_layer = 0.0;
-  double max_correcting_velocity = std::numeric_limits<double>::infinity();
+  double max_correcting_velocity = kUnbounded;
   double segment_radius = 1e-9;
   bool fixed_rotation = true;
 };
@@ -271,7 +273,8 @@ void OdeEngine::load(const Scene& scene) {
   dWorldSetQuickStepNumIterations(world_, opt_.quick_iterations);
   dWorldSetQuickStepW(world_, opt_.quick_w);
   dWorldSetContactSurfaceLayer(world_, opt_.surface_layer);
-  dWorldSetContactMaxCorrectingVel(world_, opt_.max_correcting_velocity);
+  dWorldSetContactMaxCorrectingVel(world_, opt_.max_correcting_velocity >= kUnbounded ? dInfinity
+                                                                                     : opt_.max_correcting_velocity);
   dWorldSetAutoDisableFlag(world_, 0);   // sleeping off (ODE's default)
   dWorldSetDamping(world_, 0.0, 0.0);
   space_ = dSimpleSpaceCreate(nullptr);
@@ -556,7 +559,9 @@ std::vector<Setting> OdeEngine::settings() const {
       {"cfm", fmt(opt_.cfm)},
       {"restitution_threshold", fmt(opt_.restitution_threshold) + " m/s (dSurfaceParameters::bounce_vel)"},
       {"contact_surface_layer", fmt(opt_.surface_layer)},
-      {"max_correcting_velocity", fmt(opt_.max_correcting_velocity)},
+      {"max_correcting_velocity", opt_.max_correcting_velocity >= kUnbounded
+                                      ? std::string("unbounded (dInfinity, ODE's default)")
+                                      : fmt(opt_.max_correcting_velocity)},
       {"segment_radius", fmt(opt_.segment_radius)},
       {"fixed_rotation", b(opt_.fixed_rotation)},
       {"contact_mode", "dContactBounce | dContactApprox1 (Coulomb friction mu N; the second friction direction "

@@ -10,6 +10,13 @@
 namespace physval {
 
 const std::vector<EngineFactory>& engine_registry();
+// Adds an engine (a plugin) after the built-in ones. Call it before anything looks an
+// engine up (before loading scenarios): it may move the registry's entries. Throws
+// PluginError when the name is taken.
+void register_engine(EngineFactory factory);
+// Loads and registers each `--plugin` argument (a path, or a name searched in
+// PHYSVAL_PLUGIN_PATH); returns the engines' names. Throws PluginError.
+std::vector<std::string> register_plugins(const std::vector<std::string>& args);
 // nullptr when there is no engine of that name.
 const EngineFactory* find_engine(const std::string& name);
 // The engine whose converged runs serve as the reference (nullptr: none).
