@@ -111,6 +111,11 @@ Conserved conserved_quantities(const Scene& scene) {
   else c.energy_why = "elastic, frictionless, no drag or thrust";
   c.energy = c.energy_why == "elastic, frictionless, no drag or thrust";
 
+  const bool wind = scene.world.wind.x != 0.0 || scene.world.wind.y != 0.0;
+  // A destroyed body takes its potential energy along, which can be negative (below the
+  // field's zero, or bound in a Newtonian well): destroys are left out too.
+  c.energy_non_increasing = !thrust && !particles && !(drag && wind) && !destroys;
+
   if (scene.conserves.energy) {
     c.energy = *scene.conserves.energy;
     c.energy_why = "declared by the scenario";
