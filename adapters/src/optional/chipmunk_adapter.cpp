@@ -78,7 +78,7 @@ ChipmunkDefaults chipmunk_defaults() {
 std::vector<OptionSpec> chipmunk_options() {
   const ChipmunkDefaults d = chipmunk_defaults();
   return {
-      {"iterations", std::int64_t{d.iterations}, {},
+      {"solver_iterations", std::int64_t{d.iterations}, {},
        "Solver iterations per step (cpSpaceSetIterations). Chipmunk's default.", OptionRange::between(1, 100000)},
       {"collision_slop", 0.0, {},
        "Overlap (m) Chipmunk leaves uncorrected (cpSpaceSetCollisionSlop). Chipmunk's own is 0.1 m (the float "
@@ -182,8 +182,8 @@ class ChipmunkEngine final : public Engine {
 
 void ChipmunkEngine::read_options() {
   const OptionReader r(scene_, kEngineName, info_.options);
-  const std::int64_t it = r.get_int("iterations");
-  if (it < 1 || it > 100000) throw std::invalid_argument("chipmunk.iterations must be in [1, 100000]");
+  const std::int64_t it = r.get_int("solver_iterations");
+  if (it < 1 || it > 100000) throw std::invalid_argument("chipmunk.solver_iterations must be in [1, 100000]");
   opt_.iterations = static_cast<int>(it);
   opt_.collision_slop = r.get_double("collision_slop");
   opt_.collision_bias = r.get_double("collision_bias");
@@ -475,7 +475,7 @@ std::vector<Setting> ChipmunkEngine::settings() const {
       {"step", "one cpSpaceStep(dt) per physval step: x += dt (v + v_bias), collide, v += dt (g + F / m), solve"},
       {"integration", "positions advance with the velocity the step starts with (explicit Euler in position): a free "
                       "fall lags the closed form by g dt t / 2"},
-      {"iterations", std::to_string(opt_.iterations)},
+      {"solver_iterations", std::to_string(opt_.iterations)},
       {"collision_slop", fmt(opt_.collision_slop)},
       {"collision_bias", fmt(opt_.collision_bias)},
       {"collision_persistence", std::to_string(opt_.persistence)},

@@ -93,11 +93,11 @@ OdeDefaults ode_defaults() {
 std::vector<OptionSpec> ode_options() {
   const OdeDefaults d = ode_defaults();
   return {
-      {"stepper", std::string("step"), {"step", "quickstep"},
+      {"step_mode", std::string("step"), {"step", "quickstep"},
        "'step': dWorldStep, a direct (Dantzig) LCP solve of all contacts at once; 'quickstep': dWorldQuickStep, "
        "iterative (SOR), ODE's choice for large scenes."},
       {"quickstep_iterations", std::int64_t{d.quick_iterations}, {},
-       "dWorldSetQuickStepNumIterations (stepper = quickstep). ODE's default.", OptionRange::between(1, 100000)},
+       "dWorldSetQuickStepNumIterations (step_mode = quickstep). ODE's default.", OptionRange::between(1, 100000)},
       {"quickstep_w", d.quick_w, {}, "SOR over-relaxation (dWorldSetQuickStepW). ODE's default.",
        OptionRange::between(0, 2)},
       {"erp", d.erp, {},
@@ -215,8 +215,8 @@ class OdeEngine final : public Engine {
 
 void OdeEngine::read_options() {
   const OptionReader r(scene_, kEngineName, info_.options);
-  const std::string stepper = r.get_string("stepper");
-  if (stepper != "step" && stepper != "quickstep") throw std::invalid_argument("ode.stepper must be step or quickstep");
+  const std::string stepper = r.get_string("step_mode");
+  if (stepper != "step" && stepper != "quickstep") throw std::invalid_argument("ode.step_mode must be step or quickstep");
   opt_.quickstep = stepper == "quickstep";
   const std::int64_t it = r.get_int("quickstep_iterations");
   if (it < 1 || it > 100000) throw std::invalid_argument("ode.quickstep_iterations must be in [1, 100000]");
@@ -548,7 +548,7 @@ std::vector<Setting> OdeEngine::settings() const {
       {"version", ode_version()},
       {"configuration", dGetConfiguration()},
       {"precision", "float64 (dDOUBLE)"},
-      {"stepper", opt_.quickstep ? "quickstep" : "step"},
+      {"step_mode", opt_.quickstep ? "quickstep" : "step"},
       {"step", std::string(opt_.quickstep ? "dWorldQuickStep(dt)" : "dWorldStep(dt)") +
                    " per physval step, with the contact joints of the positions the step starts from; "
                    "semi-implicit Euler: v += dt a, x += dt v"},

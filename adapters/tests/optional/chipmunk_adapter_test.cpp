@@ -154,7 +154,7 @@ TEST(ChipmunkAdapter, PublishesItsSettings) {
   auto e = make_engine("chipmunk", s);
   const auto set = e->settings();
   EXPECT_EQ(setting(set, "version"), "7.0.3");
-  EXPECT_EQ(setting(set, "iterations"), "10");
+  EXPECT_EQ(setting(set, "solver_iterations"), "10");
   EXPECT_EQ(setting(set, "collision_slop"), "0");
   EXPECT_NE(setting(set, "sleep_time_threshold").find("INFINITY"), std::string::npos);
   EXPECT_NE(setting(set, "continuous_collision").find("none"), std::string::npos);

@@ -130,9 +130,9 @@ TEST_P(EnginePlugin, SettingsArePublishedInResultsJson) {
   for (const auto& [k, v] : (*run)["settings"].items()) keys.push_back(k);
   const std::vector<std::string> wanted =
       GetParam() == "chipmunk"
-          ? std::vector<std::string>{"iterations", "collision_slop", "collision_bias", "sleep_time_threshold",
+          ? std::vector<std::string>{"solver_iterations", "collision_slop", "collision_bias", "sleep_time_threshold",
                                      "continuous_collision", "restitution_threshold", "material_rule", "integration"}
-          : std::vector<std::string>{"stepper", "erp", "cfm", "restitution_threshold", "contact_surface_layer",
+          : std::vector<std::string>{"step_mode", "erp", "cfm", "restitution_threshold", "contact_surface_layer",
                                      "auto_disable", "continuous_collision", "material_rule", "contact_mode"};
   for (const std::string& k : wanted) {
     EXPECT_NE(std::find(keys.begin(), keys.end(), k), keys.end()) << k << " in " << (*run)["settings"].dump();

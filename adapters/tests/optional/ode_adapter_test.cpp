@@ -143,7 +143,7 @@ TEST(OdeAdapter, ReproducesTheRawLibraryBitForBit) { expect_same_bits(two_balls_
 
 TEST(OdeAdapter, ReproducesTheRawLibraryBitForBitWithQuickStep) {
   Scene s = two_balls_on_a_slope();
-  s.engine_options["ode"]["stepper"] = std::string("quickstep");
+  s.engine_options["ode"]["step_mode"] = std::string("quickstep");
   expect_same_bits(s, true, 2);
 }
 
@@ -157,7 +157,7 @@ TEST(OdeAdapter, QuickStepRunsAreRepeatable) {
   // dWorldQuickStep reorders constraints with ODE's global generator; the adapter reseeds
   // it at every load, so the same scene gives the same bits twice.
   Scene s = two_balls_on_a_slope();
-  s.engine_options["ode"]["stepper"] = std::string("quickstep");
+  s.engine_options["ode"]["step_mode"] = std::string("quickstep");
   auto first = make_engine("ode", s);
   run(*first, s, s.steps());
   auto second = make_engine("ode", s);
@@ -194,7 +194,7 @@ TEST(OdeAdapter, PublishesItsSettings) {
   auto e = make_engine("ode", two_balls_on_a_slope());
   const auto set = e->settings();
   EXPECT_EQ(setting(set, "version"), "0.16.2");
-  EXPECT_EQ(setting(set, "stepper"), "step");
+  EXPECT_EQ(setting(set, "step_mode"), "step");
   EXPECT_EQ(setting(set, "erp"), "0.2");
   EXPECT_EQ(setting(set, "cfm"), "1e-10");
   EXPECT_NE(setting(set, "configuration").find("ODE_double_precision"), std::string::npos);
