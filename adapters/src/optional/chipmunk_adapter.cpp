@@ -481,7 +481,7 @@ std::vector<Setting> ChipmunkEngine::settings() const {
       {"collision_persistence", std::to_string(opt_.persistence)},
       {"fixed_rotation", b(opt_.fixed_rotation)},
       {"sleep_time_threshold", "INFINITY (sleeping off)"},
-      {"damping", "1 (cpSpaceSetDamping: no damping)"},
+      {"damping", "0 (cpSpaceSetDamping(space, 1): Chipmunk's damping is the fraction of velocity kept per second, 1 keeps it all)"},
       {"restitution_threshold", "none: Chipmunk has no restitution threshold (bounce = e v_n at every speed)"},
       {"continuous_collision", "none: Chipmunk 7 has no time of impact; missed contacts are reported in limits_hit"},
       {"material_rule",

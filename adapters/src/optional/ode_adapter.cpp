@@ -557,11 +557,13 @@ std::vector<Setting> OdeEngine::settings() const {
       {"random_seed", "dRandSetSeed(0) at every load (dWorldQuickStep reorders constraints randomly)"},
       {"erp", fmt(opt_.erp)},
       {"cfm", fmt(opt_.cfm)},
-      {"restitution_threshold", fmt(opt_.restitution_threshold) + " m/s (dSurfaceParameters::bounce_vel)"},
+      {"restitution_threshold", fmt(opt_.restitution_threshold)},
+      {"bounce_vel", fmt(opt_.restitution_threshold) + " m/s in every contact (dSurfaceParameters::bounce_vel)"},
       {"contact_surface_layer", fmt(opt_.surface_layer)},
-      {"max_correcting_velocity", opt_.max_correcting_velocity >= kUnbounded
-                                      ? std::string("unbounded (dInfinity, ODE's default)")
-                                      : fmt(opt_.max_correcting_velocity)},
+      {"max_correcting_velocity", fmt(opt_.max_correcting_velocity)},
+      {"contact_max_correcting_vel", opt_.max_correcting_velocity >= kUnbounded
+                                         ? std::string("dInfinity (unbounded, ODE's default)")
+                                         : fmt(opt_.max_correcting_velocity) + " m/s"},
       {"segment_radius", fmt(opt_.segment_radius)},
       {"fixed_rotation", b(opt_.fixed_rotation)},
       {"contact_mode", "dContactBounce | dContactApprox1 (Coulomb friction mu N; the second friction direction "
