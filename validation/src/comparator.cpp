@@ -443,6 +443,22 @@ void compare_run(RunRecord& run, const Scene& scene, const Reference& reference,
     }
   }
 
+  // core in exact mode guarantees that nothing overlaps (impacts at their exact times,
+  // resting contacts held on their constraints): an overlap beyond round-off means the
+  // guarantee broke, and the reference engine must not be ok on that run.
+  if (run.engine == "core" && run.status == RunStatus::Ok) {
+    const bool exact = std::any_of(run.settings.begin(), run.settings.end(), [](const Setting& st) {
+      return st.first == "collision" && st.second == "exact";
+    });
+    const auto pen = run.metrics["max_penetration"];
+    const double allowed = 1e-9 + 1e-12 * scales.length;
+    if (exact && pen && *pen > allowed) {
+      run.status = RunStatus::Diverged;
+      run.reason = "core's exact contacts left an overlap of " + fmt(*pen) + " m (more than round-off, " +
+                   fmt(allowed) + " m): its no-overlap guarantee broke";
+    }
+  }
+
   // Divergence from a converged reference.
   if (reference.available && reference.converged && reference.run) {
     const SeriesDivergence d = series_divergence(s, reference.run->series, same_time(run.dt, reference.dt), scales, 10.0,

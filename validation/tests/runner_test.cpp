@@ -198,6 +198,30 @@ TEST(Comparator, EnergyGainInASceneThatCanOnlyLoseEnergyIsDiverged) {
   EXPECT_EQ(windy.status, RunStatus::Ok);
 }
 
+// core in exact mode guarantees no overlap; before this rule a core run whose pile
+// collapsed into 6 cm overlaps was ok (and is the engine the others are measured against).
+TEST(Comparator, ReferenceEngineOverlapBeyondRoundOffIsDiverged) {
+  const Scene s = two_bodies();   // the fake passes the two discs through each other
+  RunRecord r = run_engine(s, fake(Fault::None), RunOptions{});
+  r.engine = "core";
+  r.settings = {{"collision", "exact"}};
+  compare_run(r, s, Reference{}, false);
+  ASSERT_TRUE(r.metrics["max_penetration"]);
+  EXPECT_GT(*r.metrics["max_penetration"], 0.5);
+  EXPECT_EQ(r.status, RunStatus::Diverged);
+  EXPECT_NE(r.reason.find("no-overlap guarantee"), std::string::npos) << r.reason;
+
+  // The lecture's one-pass scheme makes no such promise; another engine is held by its gates.
+  RunRecord lecture = run_engine(s, fake(Fault::None), RunOptions{});
+  lecture.engine = "core";
+  lecture.settings = {{"collision", "lecture"}};
+  compare_run(lecture, s, Reference{}, false);
+  EXPECT_EQ(lecture.status, RunStatus::Ok);
+  RunRecord other = run_engine(s, fake(Fault::None), RunOptions{});
+  compare_run(other, s, Reference{}, false);
+  EXPECT_EQ(other.status, RunStatus::Ok);
+}
+
 TEST(Comparator, DriftIsNullWhereNotConservedAndZeroForExactFlight) {
   Scene s = two_bodies();
   RunRecord r = run_engine(s, fake(Fault::None), RunOptions{});
