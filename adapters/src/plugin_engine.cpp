@@ -364,6 +364,10 @@ class PluginEngine final : public Engine {
     host_ = physval_host{PHYSVAL_PLUGIN_ABI_VERSION, &scene_, &host_combine, &host_response};
     const CScene c(scene_, lib_->info);
     if (t_.load(engine_, &c.scene, &host_) != 0) throw PluginError(what("load"));
+    if (body_count() < scene_.bodies.size()) {
+      throw PluginError("plugin " + lib_->info.name + ": reports " + std::to_string(body_count()) +
+                        " bodies after load, but the scene has " + std::to_string(scene_.bodies.size()));
+    }
     refresh_contacts();
   }
 
@@ -425,7 +429,30 @@ class PluginEngine final : public Engine {
     t_.contacts(engine_, &c, &n);
     contacts_.clear();
     for (std::size_t i = 0; i < n && c != nullptr; ++i) {
-      contacts_.push_back({object_ref(c[i].a, lib_->path), object_ref(c[i].b, lib_->path), c[i].time});
+      const ContactEvent e{object_ref(c[i].a, lib_->path), object_ref(c[i].b, lib_->path), c[i].time};
+      check_ref(e.a);
+      check_ref(e.b);
+      if (e.a.kind != ObjectRef::Kind::Body) {
+        throw PluginError("plugin " + lib_->info.name + ": a contact's first object must be a body");
+      }
+      contacts_.push_back(e);
+    }
+  }
+
+  // A contact naming an object that does not exist is the plugin's error, said as such
+  // (not an out-of-range read in the comparator).
+  void check_ref(const ObjectRef& r) const {
+    std::size_t count = 0;
+    const char* what = "body";
+    switch (r.kind) {
+      case ObjectRef::Kind::Body: count = body_count(); break;
+      case ObjectRef::Kind::Wall: count = scene_.walls.size(); what = "wall"; break;
+      case ObjectRef::Kind::Box: count = scene_.boxes.size(); what = "box"; break;
+      case ObjectRef::Kind::Surface: count = scene_.surfaces.size(); what = "surface"; break;
+    }
+    if (r.index >= count) {
+      throw PluginError("plugin " + lib_->info.name + ": a contact names " + what + " " + std::to_string(r.index) +
+                        ", but there are " + std::to_string(count));
     }
   }
 

@@ -136,6 +136,29 @@ TEST(PluginCli, SearchPathVariableFindsThePluginByName) {
   EXPECT_EQ(last["options"][0]["default"], "1");
 }
 
+// Bundled plugins load with every command, from beside the executable: <bin>/plugins in a
+// build tree, <bin>/../lib/physval/plugins in an installed physval.
+TEST(PluginCli, BundledPluginsLoadWithoutTheOption) {
+  for (const std::string layout : {"bin/plugins", "lib/physval/plugins"}) {
+    const fs::path d = temp_dir("bundled");
+    fs::create_directories(d / "bin");
+    fs::create_directories(d / layout);
+    fs::copy_file(PHYSVAL_EXE, d / "bin" / "physval");
+    fs::copy_file(lib("ballistic"), d / layout / "ballistic.so");
+    const std::string exe = (d / "bin" / "physval").string();
+    FILE* p = ::popen(("env -u PHYSVAL_BUNDLED_PLUGIN_DIR " + exe + " engines --json").c_str(), "r");
+    ASSERT_NE(p, nullptr);
+    std::string text;
+    char buf[4096];
+    std::size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) text.append(buf, n);
+    ASSERT_EQ(::pclose(p), 0) << text;
+    EXPECT_EQ(nlohmann::json::parse(text).back()["name"], "ballistic") << layout;
+    // And its [gate.ballistic] tables are then known to `check`.
+    EXPECT_EQ(std::system(("env -u PHYSVAL_BUNDLED_PLUGIN_DIR " + exe + " check " + kScenarios + " > /dev/null").c_str()), 0) << layout;
+  }
+}
+
 TEST(PluginCli, CheckValidatesThePluginsOptions) {
   const fs::path d = temp_dir("check");
   std::ifstream in(kScenarios + "/projectile.toml");
@@ -234,6 +257,16 @@ TEST(PluginCli, LimitsAndABrokenGuaranteeReachTheResults) {
   ASSERT_TRUE(run["diverged_at"].is_number()) << run.dump();
   EXPECT_NEAR(run["diverged_at"].get<double>(), 0.11, 1e-9);
   EXPECT_EQ(run["limits_hit"], nlohmann::json({"speed clamp: a body was held at 100 m/s"}));
+}
+
+TEST(PluginCli, AContactWithAnObjectThatDoesNotExistIsThePluginsError) {
+  int status = 0;
+  const auto run = misbehaving_run("liar", "", status);
+  EXPECT_EQ(status, 1);
+  EXPECT_EQ(run["status"], "error");
+  EXPECT_NE(run["reason"].get<std::string>().find("plugin liar: a contact names wall 99, but there are 0"),
+            std::string::npos)
+      << run.dump();
 }
 
 TEST(PluginCli, SweepRunsAPlugin) {

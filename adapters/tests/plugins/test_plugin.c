@@ -6,6 +6,7 @@
  *   1 crashy     dereferences NULL at t >= 0.05 s  4 nanny     velocities turn NaN at t >= 0.05 s
  *   2 hangy      never returns from step at 0.05 s 5 failing   step reports an error at 0.05 s
  *   6 strained   reports a limit hit from 0.05 s on and a broken guarantee in the step that ends past 0.1 s
+ *   7 liar       reports a contact with wall 99 (the scene has none) in the step that ends past 0.05 s
  */
 #include <math.h>
 #include <stdio.h>
@@ -30,8 +31,10 @@
 #define NAME "nanny"
 #elif TEST_PLUGIN_MODE == 5
 #define NAME "failing"
-#else
+#elif TEST_PLUGIN_MODE == 6
 #define NAME "strained"
+#else
+#define NAME "liar"
 #endif
 
 #define TROUBLE_AT 0.05
@@ -156,10 +159,11 @@ static void read_states(const physval_engine* e, physval_body_state* out, size_t
   for (i = 0; i < n && i < e->count; ++i) out[i] = e->bodies[i].s;
 }
 
+static const physval_contact kNoSuchWall = {{PHYSVAL_OBJECT_BODY, 0}, {PHYSVAL_OBJECT_WALL, 99}, 0.06};
+
 static void contacts(const physval_engine* e, const physval_contact** out, size_t* count) {
-  (void)e;
-  *out = NULL;
-  *count = 0;
+  *out = &kNoSuchWall;
+  *count = TEST_PLUGIN_MODE == 7 && e->t > TROUBLE_AT ? 1 : 0;
 }
 
 static void settings(const physval_engine* e, const physval_setting** out, size_t* count) {
