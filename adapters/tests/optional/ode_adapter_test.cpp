@@ -209,7 +209,12 @@ TEST(OdeAdapter, PublishesItsSettings) {
 TEST(OdeAdapter, ZeroSegmentRadiusIsRefused) {
   Scene s = two_balls_on_a_slope();
   s.engine_options["ode"]["segment_radius"] = 0.0;
-  EXPECT_THROW(make_engine("ode", s), std::invalid_argument);
+  try {
+    make_engine("ode", s);
+    FAIL() << "loaded with segment_radius 0";
+  } catch (const std::exception& err) {   // through the plugin: the loader's PluginError
+    EXPECT_NE(std::string(err.what()).find("segment_radius must be > 0"), std::string::npos) << err.what();
+  }
 }
 
 }  // namespace
