@@ -4,7 +4,7 @@
 set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
-  libbox2d-dev libbullet-dev libeigen3-dev
+  libbox2d-dev libbullet-dev libeigen3-dev libchipmunk-dev libode-dev
   libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libbenchmark-dev
   gnuplot-nox
