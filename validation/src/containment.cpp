@@ -95,6 +95,12 @@ ContainmentMonitor::ContainmentMonitor(const Scene& scene) : scene_(scene) {
   for (std::size_t i : moving_) {
     for (const Barrier& b : barriers_) any = any || blocks_[body_group_[i]][b.group];
   }
+  // So do passes between moving bodies (one centre inside the other) when any two collide.
+  for (std::size_t p = 0; p < moving_.size() && !any; ++p) {
+    for (std::size_t q = p + 1; q < moving_.size() && !any; ++q) {
+      any = pair_collides_[body_group_[moving_[p]] * n_body_groups_ + body_group_[moving_[q]]] != 0;
+    }
+  }
   if (any) record_.escaped_bodies = 0;
 
   use_grid_ = barriers_.size() > kBruteForceBarriers;
@@ -210,6 +216,20 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
       const double depth = radius(i) + radius(j) - length(xi - position(j));
       if (depth > record_.max_penetration) {
         penetration(depth, t, scene_.bodies[std::min(i, j)].name + " / " + scene_.bodies[std::max(i, j)].name);
+      }
+      // Passed into each other: the centres closer than the smaller radius (each centre
+      // inside the other body; overlap deeper than the larger radius). No solver's slop
+      // comes near it: the pair has gone through, or is on its way.
+      if (depth > std::max(radius(i), radius(j)) + eps_ && std::min(radius(i), radius(j)) > 0.0) {
+        for (const std::size_t k : {i, j}) {
+          if (escaped_[k]) continue;
+          escaped_[k] = 1;
+          ++*record_.escaped_bodies;
+          if (!record_.first_escape_time) {
+            record_.first_escape_time = t;
+            record_.first_escape = scene_.bodies[k].name + " into body '" + scene_.bodies[k == i ? j : i].name + "'";
+          }
+        }
       }
     }
   }
