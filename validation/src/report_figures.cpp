@@ -86,8 +86,6 @@ std::optional<Table> read_table(const fs::path& file) {
 
 namespace {
 
-constexpr const char* kReferenceColour = "#a8a8a8";
-
 // Colour and dash of an engine: by its place among all engines of the results, so an
 // engine looks the same in every plot of the report.
 struct Look {
@@ -126,6 +124,11 @@ plot::Series curve(const Source& s, const std::vector<std::string>& engines, con
 }
 
 }  // namespace
+
+std::string engine_colour(const std::vector<std::string>& engines, const std::string& engine) {
+  const Look l = look_of(engines, engine);
+  return plot::palette()[static_cast<std::size_t>(l.colour) % plot::palette().size()];
+}
 
 std::string reference_label(const json* ref) {
   std::string label = "reference";
