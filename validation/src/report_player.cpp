@@ -5,7 +5,8 @@
 //   positions: for each body, for each frame, x then y, each a varint: 0 = the body is
 //              not there (not yet spawned, destroyed), else zigzag(q - previous q) + 1,
 //              q = round((coordinate - origin) / quantum), previous q starting at 0;
-//   energy:    one float32 (little-endian) per frame, NaN where unknown;
+//   energy:    one float32 (little-endian) per frame: E(t) - E(0), NaN where unknown
+//              (E(0) is the header's source "e0");
 //   contacts:  varint count, then per contact (sorted by time) varint a, varint b
 //              (indexes into the header's "objects": bodies, then barriers) and varint
 //              time - previous time in ticks of duration / 2^20.
@@ -268,7 +269,18 @@ PlayerSection player_section(const ScenarioView& v, const std::vector<std::strin
         prev_y = qy;
       }
     }
-    for (std::size_t k = 0; k < frames; ++k) put_float32(coded, r.energy[k]);
+    // Energy as E(t) - E(0), subtracted in double: a drift at round-off (1e-13 J of 40 J)
+    // survives float32, which E(t) itself would not.
+    double e0 = NAN;
+    if (const auto* e = src.table.column("energy")) {
+      for (double value : *e) {
+        if (std::isfinite(value)) {
+          e0 = value;
+          break;
+        }
+      }
+    }
+    for (std::size_t k = 0; k < frames; ++k) put_float32(coded, r.energy[k] - e0);
     const json* holder = nullptr;
     if (src.engine.empty()) {
       holder = v.reference;
@@ -290,6 +302,7 @@ PlayerSection player_section(const ScenarioView& v, const std::vector<std::strin
     const bool reference = src.engine.empty();
     sources.push_back({{"label", src.label},
                        {"engine", src.engine},
+                       {"e0", std::isfinite(e0) ? json(e0) : json(nullptr)},
                        {"colour", reference ? std::string(kReferenceColour) : engine_colour(engines, src.engine)}});
     section.raw_bytes += frames * bodies.size() * 2 * 8 + frames * 8 + contacts.size() * 3 * 8;
   }

@@ -106,8 +106,7 @@ function decode(h, u) {
       tick += varint();
       ct[i] = tick / h.contact_ticks * h.duration;
     }
-    let e0 = NaN;
-    for (let k = 0; k < N; k++) if (isFinite(energy[k])) { e0 = energy[k]; break; }
+    const e0 = h.sources[s].e0 === null ? NaN : h.sources[s].e0;
     out.push({ pos, energy, e0, ca, cb, ct });
   }
   if (p !== u.length) throw new Error('player data for ' + h.scenario + ' has ' + (u.length - p) + ' bytes left over');
@@ -153,9 +152,9 @@ class Player {
     this.shown = h.sources.map(() => true);
     this.build();
     const d = h.duration;
-    this.speed = 1;
-    for (const s of SPEEDS) { if (d <= 20 * s) { this.speed = s; break; } }
-    if (d > 20 * SPEEDS[SPEEDS.length - 1]) this.speed = SPEEDS[SPEEDS.length - 1];
+    // Real time, unless that would take over 20 s: then fast enough to play in about 20 s.
+    this.speed = SPEEDS[SPEEDS.length - 1];
+    for (const s of SPEEDS) { if (s >= 1 && d <= 20 * s) { this.speed = s; break; } }
     this.speedSelect.value = String(this.speed);
     this.show(startAt !== null && isFinite(startAt) ? Math.min(Math.max(startAt, 0), d) : 0);
   }
@@ -379,7 +378,7 @@ class Player {
     this.timeText.textContent = 't = ' + fmt(t, 4) + ' s of ' + fmt(h.duration, 4) + ' s';
     h.sources.forEach((s, si) => {
       const d = this.data[si], c = this.cells[si];
-      const de = d.energy[k] - d.e0;
+      const de = d.energy[k];
       c.de.textContent = fmt(de, 3);
       c.rel.textContent = d.e0 !== 0 ? fmt(Math.abs(de / d.e0), 3) : '\u2013';
       c.nc.textContent = String(countUpTo(d.ct, t));
