@@ -5,9 +5,11 @@
 // Page hash options (for links, screenshots and the browser test):
 //   #only=NAME   show only that scenario's player (a screenshot of it);
 //   t=SECONDS    start there;
+//   play         start playing at once (data-fps on each player: frames drawn per second);
 //   selftest     draw every frame of every player once, then set on <html>
 //                data-player-status="ok" and data-players=N, and on each player
-//                data-frames-drawn and data-ink (pixels that are not background).
+//                data-frames-drawn, data-bodies-drawn (most bodies of one source in the
+//                last frame) and data-ink (pixels that are not background).
 // Any script error is recorded on <html> as data-script-errors by a handler installed
 // first, in its own <script>, so even a syntax error in the player shows.
 #include "report_player.hpp"
@@ -48,6 +50,7 @@ const params = new URLSearchParams(location.hash.slice(1));
 const selftest = params.has('selftest');
 const only = params.get('only');
 const startAt = params.has('t') ? parseFloat(params.get('t')) : null;
+const autoplay = params.has('play');
 const SPEEDS = [0.01, 0.1, 0.25, 0.5, 1, 2, 5, 10, 30, 100, 300, 1000];
 
 function bytesOf(text) {
@@ -245,8 +248,12 @@ class Player {
     this.playing = true;
     this.button.textContent = '\u23F8 pause';
     let last = performance.now();
+    const began = last, drawnBefore = this.framesDrawn;
     const step = (now) => {
       if (!this.playing) return;
+      if (now > began) {   // how fast it plays here: drawn frames per second of wall time
+        this.root.setAttribute('data-fps', ((this.framesDrawn - drawnBefore) / ((now - began) / 1000)).toFixed(1));
+      }
       this.t = Math.min(this.h.duration, this.t + (now - last) / 1000 * this.speed);
       last = now;
       this.show(this.t);
@@ -302,33 +309,37 @@ class Player {
       ctx.strokeRect(x, y, w, hh);
     }
 
-    // Bodies: the reference filled underneath, each engine a ring a little wider than the last.
+    // Bodies: the reference filled underneath, each engine a ring a little wider than the
+    // last. Each disc or ring is drawn once into a sprite and copied (a gas of hundreds of
+    // bodies is hundreds of copies a frame, not hundreds of anti-aliased paths).
     let ring = 0;
+    let drawn = 0;
     h.sources.forEach((s, si) => {
       if (!this.shown[si]) { if (s.engine) ring++; return; }
       const pos = this.data[si].pos;
-      ctx.beginPath();
+      const lineWidth = B > 50 ? 1.2 : 1.8;
+      let count = 0;
       for (let b = 0; b < B; b++) {
         const i = (b * N + k) * 2;
         const x = pos[i], y = pos[i + 1];
         if (x !== x) continue;
         const r = Math.max(h.bodies[b][1] * this.scale, 2.5) + (s.engine ? 1.6 * ring : 0);
         const cx = this.px(x), cy = this.py(y);
-        ctx.moveTo(cx + r, cy);
-        ctx.arc(cx, cy, r, 0, 2 * Math.PI);
+        count++;
+        if (r > 120) {   // a large body: drawn directly (few of them)
+          ctx.beginPath();
+          ctx.arc(cx, cy, r, 0, 2 * Math.PI);
+          if (s.engine) { ctx.strokeStyle = s.colour; ctx.lineWidth = lineWidth; ctx.stroke(); }
+          else { ctx.fillStyle = s.colour; ctx.globalAlpha = 0.75; ctx.fill(); ctx.globalAlpha = 1; }
+          continue;
+        }
+        const sprite = this.sprite(s.colour, r, s.engine ? lineWidth : 0);
+        ctx.drawImage(sprite, cx - sprite.half, cy - sprite.half, 2 * sprite.half, 2 * sprite.half);
       }
-      if (s.engine) {
-        ctx.strokeStyle = s.colour;
-        ctx.lineWidth = B > 50 ? 1.2 : 1.8;
-        ctx.stroke();
-        ring++;
-      } else {
-        ctx.fillStyle = s.colour;
-        ctx.globalAlpha = 0.75;
-        ctx.fill();
-        ctx.globalAlpha = 1;
-      }
+      if (s.engine) ring++;
+      drawn = Math.max(drawn, count);
     });
+    this.root.setAttribute('data-bodies-drawn', String(drawn));
 
     // Names, when there are few enough to read (at the reference's or first source's place).
     if (B <= 12 && this.data.length) {
@@ -343,28 +354,38 @@ class Player {
       }
     }
 
-    // Contacts that began in the last few frames: a ring that widens and fades.
+    // Contacts that began in the last few frames: a ring that widens and fades (rings of
+    // one source and about one age stroked together).
     const window_ = Math.max(3 * frameDt, h.duration / 150);
+    const ages = 4;
+    ctx.lineWidth = 2.5;
     h.sources.forEach((s, si) => {
       if (!this.shown[si]) return;
       const d = this.data[si];
       const end = countUpTo(d.ct, t);
-      for (let c = countUpTo(d.ct, t - window_); c < end; c++) {
-        const age = (t - d.ct[c]) / window_;
-        let x = 0, y = 0, n = 0, r = 0;
-        for (const o of [d.ca[c], d.cb[c]]) {
-          if (o >= B) continue;
-          const i = (o * N + k) * 2;
-          if (d.pos[i] !== d.pos[i]) continue;
-          x += d.pos[i]; y += d.pos[i + 1]; n++;
-          r = Math.max(r, h.bodies[o][1] * this.scale);
-        }
-        if (!n) continue;
-        ctx.globalAlpha = Math.max(0, 1 - age);
-        ctx.strokeStyle = s.engine ? s.colour : '#666';
-        ctx.lineWidth = 2.5;
+      const first = countUpTo(d.ct, t - window_);
+      if (first >= end) return;
+      ctx.strokeStyle = s.engine ? s.colour : '#666';
+      for (let a = 0; a < ages; a++) {
         ctx.beginPath();
-        ctx.arc(this.px(x / n), this.py(y / n), (n > 1 ? 0.5 * r : r) + 5 + 14 * age, 0, 2 * Math.PI);
+        for (let c = first; c < end; c++) {
+          const age = (t - d.ct[c]) / window_;
+          if (Math.min(ages - 1, Math.floor(age * ages)) !== a) continue;
+          let x = 0, y = 0, n = 0, r = 0;
+          for (const o of [d.ca[c], d.cb[c]]) {
+            if (o >= B) continue;
+            const i = (o * N + k) * 2;
+            if (d.pos[i] !== d.pos[i]) continue;
+            x += d.pos[i]; y += d.pos[i + 1]; n++;
+            r = Math.max(r, h.bodies[o][1] * this.scale);
+          }
+          if (!n) continue;
+          const radius = (n > 1 ? 0.5 * r : r) + 5 + 14 * (a + 0.5) / ages;
+          const cx = this.px(x / n), cy = this.py(y / n);
+          ctx.moveTo(cx + radius, cy);
+          ctx.arc(cx, cy, radius, 0, 2 * Math.PI);
+        }
+        ctx.globalAlpha = 1 - a / ages;
         ctx.stroke();
       }
       ctx.globalAlpha = 1;
@@ -385,6 +406,27 @@ class Player {
     });
     this.framesDrawn++;
     this.root.setAttribute('data-frames-drawn', String(this.framesDrawn));
+  }
+
+  // A disc (lineWidth 0: the reference, translucent) or a ring, radius r CSS pixels.
+  sprite(colour, r, lineWidth) {
+    const key = colour + '|' + Math.round(r * 4) + '|' + lineWidth;
+    this.sprites = this.sprites || new Map();
+    let c = this.sprites.get(key);
+    if (c) return c;
+    const ratio = window.devicePixelRatio || 1;
+    const half = Math.ceil(r + lineWidth + 1);
+    c = document.createElement('canvas');
+    c.width = c.height = Math.ceil(2 * half * ratio);
+    c.half = half;
+    const g = c.getContext('2d');
+    g.setTransform(ratio, 0, 0, ratio, 0, 0);
+    g.beginPath();
+    g.arc(half, half, r, 0, 2 * Math.PI);
+    if (lineWidth > 0) { g.strokeStyle = colour; g.lineWidth = lineWidth; g.stroke(); }
+    else { g.globalAlpha = 0.75; g.fillStyle = colour; g.fill(); }
+    this.sprites.set(key, c);
+    return c;
   }
 
   ink() {
@@ -427,6 +469,7 @@ async function start() {
       p.root.setAttribute('data-ink', String(p.ink()));
     }
   }
+  if (autoplay) for (const p of players) p.play();
   document.documentElement.setAttribute('data-players', String(players.length));
   document.documentElement.setAttribute('data-player-status', failures.length ? 'failed' : 'ok');
 }
