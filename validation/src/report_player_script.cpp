@@ -9,7 +9,8 @@
 //   selftest     draw every frame of every player once, then set on <html>
 //                data-player-status="ok" and data-players=N, and on each player
 //                data-frames-drawn, data-bodies-drawn (most bodies of one source in the
-//                last frame) and data-ink (pixels that are not background).
+//                last frame), data-ink (pixels that are not background) and
+//                data-barrier-ink (the near-black pixels barriers are drawn with).
 // Any script error is recorded on <html> as data-script-errors by a handler installed
 // first, in its own <script>, so even a syntax error in the player shows.
 #include "report_player.hpp"
@@ -429,11 +430,17 @@ class Player {
     return c;
   }
 
+  // Pixels drawn (not background), and of those the barriers' near-black ones below the
+  // title line (bodies are coloured or grey, names #444: neither counts as dark).
   ink() {
     const c = this.canvas, img = this.ctx.getImageData(0, 0, c.width, c.height).data;
-    let n = 0;
-    for (let i = 0; i < img.length; i += 4) if (img[i] < 245 || img[i + 1] < 245 || img[i + 2] < 245) n++;
-    return n;
+    const titleRows = Math.ceil(24 * c.height / this.height);
+    let n = 0, dark = 0;
+    for (let i = 0; i < img.length; i += 4) {
+      if (img[i] < 245 || img[i + 1] < 245 || img[i + 2] < 245) n++;
+      if (img[i] <= 64 && img[i + 1] <= 64 && img[i + 2] <= 64 && i / 4 >= titleRows * c.width) dark++;
+    }
+    return [n, dark];
   }
 }
 
@@ -466,7 +473,9 @@ async function start() {
       for (let k = 0; k < p.h.frames; k++) p.draw(k, true);
       p.show(startAt !== null ? startAt : 0);
       p.draw(p.frame, true);
-      p.root.setAttribute('data-ink', String(p.ink()));
+      const [ink, dark] = p.ink();
+      p.root.setAttribute('data-ink', String(ink));
+      p.root.setAttribute('data-barrier-ink', String(dark));
     }
   }
   if (autoplay) for (const p of players) p.play();
