@@ -101,11 +101,11 @@ std::string checks_html(const json& run) {
     }
     std::string line = html(str(c, "what"));
     if (auto v = num(c, "value")) {
-      line += " " + fmt(*v);
+      line.append(" ").append(fmt(*v));
     } else {
       line += " (not measured)";
     }
-    if (auto l = num(c, "limit")) line += " &gt; " + fmt(*l);
+    if (auto l = num(c, "limit")) line.append(" &gt; ").append(fmt(*l));
     if (!is_enforced) line += " <span class=grey>(gate, not enforced)</span>";
     failures += "<br>" + line;
   }
@@ -124,6 +124,8 @@ std::string metrics_table(const ScenarioView& v) {
   os << "<table><tr><th>engine</th><th>status</th><th>energy drift</th><th>momentum drift</th>"
         "<th>angular momentum drift</th><th>energy divergence</th><th>momentum divergence</th>"
         "<th>position divergence</th><th>first contact</th><th>contact time error</th><th>missed / extra contacts</th>"
+        "<th title=\"deepest overlap of a body with another body or a barrier\">max penetration</th>"
+        "<th title=\"bodies that left the region the scene's barriers enclose\">escaped bodies</th>"
         "<th>wall time</th><th>checks</th></tr>\n";
   for (const json* run : v.runs) {
     const json& m = member(*run, "metrics");
@@ -145,6 +147,13 @@ std::string metrics_table(const ScenarioView& v) {
          << "</td>";
     } else {
       os << "<td class=na>&ndash;</td>";
+    }
+    os << metric_cell(m, "max_penetration", " m");
+    if (auto escaped = num(m, "escaped_bodies")) {
+      os << "<td class=num" << (*escaped > 0.0 ? " style=\"color:#b3261e;font-weight:600\"" : "") << ">"
+         << fmt(*escaped, "%.0f") << "</td>";
+    } else {
+      os << "<td class=na title=\"does not apply or not measured\">&ndash;</td>";
     }
     if (auto w = num(*run, "wall_seconds"); w && status != "unsupported") {
       os << "<td class=num>" << fmt(*w) << " s</td>";
