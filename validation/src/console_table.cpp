@@ -116,13 +116,13 @@ void print_suite_table(std::ostream& os, const SuiteResult& result) {
                      " within the bounds recorded in [gate." + r.engine + "] known_failures:");
         for (const Check& c : r.checks) {
           if (!(c.known_failure && c.pass)) continue;
-          note(os, "- " + c.what + ": " + off(c) + (c.value ? ", bound " + num(c.limit, "%.3g") : std::string("")) + ")");
+          note(os, "- " + c.what + ": " + off(c) + (c.value ? (c.detail.empty() ? "bound " : ", bound ") + num(c.limit, "%.3g") : std::string("")) + ")");
         }
       }
       for (const Check& c : r.checks) {
         if (c.pass) continue;
         const std::string limit = c.known_failure ? "bound " : c.what.rfind("expect.", 0) == 0 ? "tolerance " : "limit ";
-        const std::string sep = c.detail.empty() && !c.value ? "" : ", ";
+        const std::string sep = c.detail.empty() ? "" : ", ";
         if (c.enforced) {
           note(os, r.engine + " FAILED " + c.what + ": " + off(c) + sep + limit + num(c.limit, "%.3g") + ")");
         } else {
