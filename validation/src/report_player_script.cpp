@@ -355,10 +355,11 @@ class Player {
       }
     }
 
-    // Contacts that began in the last few frames: a ring that widens and fades (rings of
-    // one source and about one age stroked together).
+    // Contacts that began in the last few frames: a ring that widens and fades. Only the
+    // latest of each pair, and at most kMaxFlashes a source: a pair that touches
+    // thousands of times in a blink (pi_billiard_1e8) is one ring, not thousands.
     const window_ = Math.max(3 * frameDt, h.duration / 150);
-    const ages = 4;
+    const ages = 4, kMaxFlashes = 80;
     ctx.lineWidth = 2.5;
     h.sources.forEach((s, si) => {
       if (!this.shown[si]) return;
@@ -366,23 +367,29 @@ class Player {
       const end = countUpTo(d.ct, t);
       const first = countUpTo(d.ct, t - window_);
       if (first >= end) return;
+      const byAge = [[], [], [], []];
+      const seen = new Set();
+      for (let c = end - 1; c >= first && seen.size < kMaxFlashes; c--) {
+        const pair = d.ca[c] * 1e6 + d.cb[c];
+        if (seen.has(pair)) continue;
+        seen.add(pair);
+        let x = 0, y = 0, n = 0, r = 0;
+        for (const o of [d.ca[c], d.cb[c]]) {
+          if (o >= B) continue;
+          const i = (o * N + k) * 2;
+          if (d.pos[i] !== d.pos[i]) continue;
+          x += d.pos[i]; y += d.pos[i + 1]; n++;
+          r = Math.max(r, h.bodies[o][1] * this.scale);
+        }
+        if (!n) continue;
+        const a = Math.min(ages - 1, Math.floor((t - d.ct[c]) / window_ * ages));
+        byAge[a].push([this.px(x / n), this.py(y / n), (n > 1 ? 0.5 * r : r) + 5 + 14 * (a + 0.5) / ages]);
+      }
       ctx.strokeStyle = s.engine ? s.colour : '#666';
       for (let a = 0; a < ages; a++) {
+        if (!byAge[a].length) continue;
         ctx.beginPath();
-        for (let c = first; c < end; c++) {
-          const age = (t - d.ct[c]) / window_;
-          if (Math.min(ages - 1, Math.floor(age * ages)) !== a) continue;
-          let x = 0, y = 0, n = 0, r = 0;
-          for (const o of [d.ca[c], d.cb[c]]) {
-            if (o >= B) continue;
-            const i = (o * N + k) * 2;
-            if (d.pos[i] !== d.pos[i]) continue;
-            x += d.pos[i]; y += d.pos[i + 1]; n++;
-            r = Math.max(r, h.bodies[o][1] * this.scale);
-          }
-          if (!n) continue;
-          const radius = (n > 1 ? 0.5 * r : r) + 5 + 14 * (a + 0.5) / ages;
-          const cx = this.px(x / n), cy = this.py(y / n);
+        for (const [cx, cy, radius] of byAge[a]) {
           ctx.moveTo(cx + radius, cy);
           ctx.arc(cx, cy, radius, 0, 2 * Math.PI);
         }
