@@ -222,7 +222,7 @@ plot::Figure energy_figure(const ScenarioView& v, const std::vector<std::string>
 plot::Figure momentum_figure(const ScenarioView& v, const std::vector<std::string>& engines) {
   plot::Figure fig;
   fig.title = v.name + ": momentum over time";
-  fig.height = 950;
+  fig.height = 1050;   // the legend under the last panel takes from its height
   struct Part {
     const char* column;
     const char* title;
@@ -237,6 +237,10 @@ plot::Figure momentum_figure(const ScenarioView& v, const std::vector<std::strin
     p.x.label = "time (s)";
     p.y.label = part.unit;
     p.key = "outside right top";
+    if (v.duration > 0.0) {   // every panel over the whole run, so their time axes line up
+      p.x.min = 0.0;
+      p.x.max = v.duration;
+    }
     for (const Source& s : v.sources) {
       const auto* t = s.table.column("t");
       const auto* y = s.table.column(part.column);
