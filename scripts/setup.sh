@@ -7,7 +7,7 @@ packages=(
   libbox2d-dev libbullet-dev libeigen3-dev libchipmunk-dev libode-dev
   libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libbenchmark-dev
-  gnuplot-nox
+  gnuplot-nox zlib1g-dev chromium
   python3
   clang-14 libclang-rt-14-dev
 )
