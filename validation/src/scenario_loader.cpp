@@ -1009,7 +1009,12 @@ Scene read_scene(Context& ctx, const toml::table& root) {
     double seed = 1.0;
     er.read("seed", seed, "a whole number >= 0", [](double v) { return v >= 0.0 && v == std::floor(v); });
     e.seed = static_cast<std::uint64_t>(seed);
-    if (e.mode == EmitterMode::Explode && e.count == 0) er.error_here("count", "an exploding emitter needs count > 0");
+    // A count already refused above is not refused again for being 0 (it was never read).
+    const toml::node* count_node = emitters[i]->get("count");
+    const bool count_refused = count_node != nullptr && !(count_node->value<double>() && *count_node->value<double>() == count);
+    if (e.mode == EmitterMode::Explode && e.count == 0 && !count_refused) {
+      er.error_here("count", "an exploding emitter needs count > 0");
+    }
     if (e.mode == EmitterMode::Trail && e.rate <= 0.0) er.error_here("rate", "a trail emitter needs rate > 0");
     s.emitters.push_back(e);
   }

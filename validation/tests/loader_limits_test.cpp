@@ -83,6 +83,8 @@ TEST(LoaderBounds, EmitterCountStatesItsBoundOnce) {
   EXPECT_NE(all_errors(load).find("emitters[0].count: must be a whole number from 0 to 1000000, got 100000000"),
             std::string::npos)
       << all_errors(load);
+  // ... and does not then contradict itself with "needs count > 0" (the count was refused).
+  EXPECT_EQ(all_errors(load).find("needs count > 0"), std::string::npos) << all_errors(load);
 }
 
 TEST(LoaderBounds, ParticlesFromATrailBeyondTheBoundAreRefusedBeforeRunning) {
