@@ -21,6 +21,8 @@
 // body does not rest on it: it micro-bounces (exact_collisions.cpp).
 #include <algorithm>
 #include <cmath>
+#include <numbers>
+#include <span>
 
 #include "physval/core/time_of_impact.hpp"
 #include "world.hpp"
@@ -69,7 +71,9 @@ void support_path(World& w, std::uint32_t i) {
 }
 
 void release_support(World& w, std::uint32_t i) {
-  if (w.on_body(i)) {   // unlink from the supporter's list of dependents
+  if (w.is_held(i)) {   // forget its contacts
+    std::erase_if(w.held, [i](const HeldContact& c) { return c.body == i; });
+  } else if (w.on_body(i)) {   // unlink from the supporter's list of dependents
     const std::uint32_t j = w.support[i] & ~kBodySupport;
     std::uint32_t* link = &w.dep_head[j];
     while (*link != kNone && *link != i) link = &w.dep_next[*link];
@@ -111,6 +115,115 @@ void collect_dependents(World& w, std::uint32_t j) {
 
 namespace {
 
+// Whether the unit direction d lies in the convex cone spanned by the unit vectors g
+// (within `tol` radians of it): some generator along d, or two generators on either side
+// of d less than pi apart.
+bool in_cone(Vec2 d, std::span<const Vec2> g, double tol) {
+  double ccw = INFINITY, cw = -INFINITY;   // nearest generator angle on each side of d
+  for (const Vec2& x : g) {
+    const double phi = std::atan2(cross(d, x), dot(d, x));
+    if (std::fabs(phi) <= tol) return true;
+    if (phi > 0.0) {
+      ccw = std::min(ccw, phi);
+    } else {
+      cw = std::max(cw, phi);
+    }
+  }
+  return std::isfinite(ccw) && std::isfinite(cw) && ccw - cw < std::numbers::pi - tol;
+}
+
+bool related_bodies(const World& w, std::uint32_t i, std::uint32_t j) {
+  const std::size_t s = w.scene_bodies;
+  if ((w.flags[i] & kParticle) && w.parent[i - s] == j) return true;
+  if ((w.flags[j] & kParticle) && w.parent[j - s] == i) return true;
+  return false;
+}
+
+double holding_coefficient(const PairMaterial& m) {
+  return m.rolling_friction > 0.0 ? m.rolling_friction : std::max(m.static_friction, m.friction);
+}
+
+}  // namespace
+
+// The contacts that could hold body i now: faces it touches (within 1e-9 of its size
+// and the scene's), and stationary bodies in `near` it touches.
+static void touching_supports(World& w, std::uint32_t i, std::span<const std::uint32_t> near,
+                              std::vector<HeldContact>& out, std::vector<double>& mu) {
+  const double r = w.radius[i];
+  const Vec2 p = w.pos[i];
+  if (!w.statics.segments.empty()) {
+    const double tol = 1e-9 * (r + w.length_scale);
+    w.found_static.clear();
+    w.statics.query(make_aabb(p.x - r - tol, p.y - r - tol, p.x + r + tol, p.y + r + tol), w.found_static);
+    for (std::uint32_t k : w.found_static) {
+      const Segment& s = w.statics.segments[k];
+      if (w.any_rules && !w.response(w.group[i], s.group).collide) continue;
+      const double u = dot(p - s.from, s.dir);
+      if (u < 0.0 || u > s.length) continue;
+      const double D = dot(p - s.from, s.normal);
+      if (std::fabs(std::fabs(D) - r) > tol) continue;
+      out.push_back({i, kBodySupport | k, D >= 0.0 ? s.normal : -s.normal});
+      mu.push_back(holding_coefficient(w.pair_material(w.material[i], s.material)));
+    }
+  }
+  for (std::uint32_t j : near) {
+    if (j == i || !w.alive(j) || !w.stationary(j)) continue;
+    if ((w.flags[i] & kPoint) && (w.flags[j] & kPoint)) continue;
+    if (((w.flags[i] | w.flags[j]) & kParticle) && related_bodies(w, i, j)) continue;
+    if (w.any_rules && !w.response(w.group[i], w.group[j]).collide) continue;
+    const Vec2 d = p - w.pos[j];
+    const double dist = length(d);
+    const double R = r + w.radius[j];
+    if (!(dist > 0.0) || std::fabs(dist - R) > 1e-9 * (R + w.length_scale)) continue;
+    out.push_back({i, j, d / dist});
+    mu.push_back(holding_coefficient(w.pair_material(w.material[i], w.material[j])));
+  }
+}
+
+bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near) {
+  if (!w.dynamic(i) || w.is_held(i) || w.acc.empty()) return false;
+  const Vec2 a = w.acc[i];
+  const double amag = length(a);
+  if (!(amag > 0.0)) return false;   // nothing to hold against
+  if (length(w.vel[i]) > w.rest_speed(amag, dt)) return false;
+  thread_local std::vector<HeldContact> contacts;
+  thread_local std::vector<double> mu;
+  thread_local std::vector<Vec2> gens;
+  contacts.clear();
+  mu.clear();
+  gens.clear();
+  touching_supports(w, i, near, contacts, mu);
+  if (contacts.empty()) return false;
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const Vec2 n = contacts[k].n;
+    gens.push_back(n);
+    if (mu[k] > 0.0) {   // the edges of the static friction cone
+      const double th = std::atan(mu[k]);
+      gens.push_back(std::cos(th) * n + std::sin(th) * perp(n));
+      gens.push_back(std::cos(th) * n - std::sin(th) * perp(n));
+    }
+  }
+  const Vec2 d = (-1.0 / amag) * a;   // the direction the supports must push
+  if (!in_cone(d, gens, 1e-12)) return false;
+  release_support(w, i);
+  w.vel[i] = {};
+  w.apath[i] = {};
+  w.support[i] = kHeld;
+  w.support_n[i] = d;
+  w.held.insert(w.held.end(), contacts.begin(), contacts.end());
+  return true;
+}
+
+void unhold(World& w, std::uint32_t i) { release_support(w, i); }
+
+void held_on(const World& w, std::uint32_t j, std::vector<std::uint32_t>& out) {
+  for (const HeldContact& c : w.held) {
+    if (c.other == j && std::find(out.begin(), out.end(), c.body) == out.end()) out.push_back(c.body);
+  }
+}
+
+namespace {
+
 // A body touching a face, pressed into it and not moving away, settles onto it at the
 // start of the step (so that even explicit Euler, which applies a force only at the
 // end of a step, never pulls a resting body into its support).
@@ -139,9 +252,104 @@ void detect_support(World& w, std::uint32_t i, const StepContext& ctx) {
   }
 }
 
+// The stationary bodies near a point: a uniform grid over them, rebuilt per pass.
+class NearGrid {
+ public:
+  void build(const World& w, double cell) {
+    cell_ = cell;
+    keyed_.clear();
+    for (std::uint32_t j = 0; j < w.size(); ++j) {
+      if (w.alive(j) && w.stationary(j)) keyed_.push_back({key(w.pos[j]), j});
+    }
+    std::sort(keyed_.begin(), keyed_.end());
+  }
+  void query(Vec2 p, std::vector<std::uint32_t>& out) const {
+    out.clear();
+    const auto cx = static_cast<std::int64_t>(std::floor(p.x / cell_));
+    const auto cy = static_cast<std::int64_t>(std::floor(p.y / cell_));
+    for (std::int64_t dx = -1; dx <= 1; ++dx) {
+      for (std::int64_t dy = -1; dy <= 1; ++dy) {
+        const std::uint64_t k = pack(cx + dx, cy + dy);
+        auto it = std::lower_bound(keyed_.begin(), keyed_.end(), std::pair<std::uint64_t, std::uint32_t>{k, 0});
+        for (; it != keyed_.end() && it->first == k; ++it) out.push_back(it->second);
+      }
+    }
+  }
+
+ private:
+  static std::uint64_t pack(std::int64_t x, std::int64_t y) {
+    return (static_cast<std::uint64_t>(x) << 32) ^ static_cast<std::uint32_t>(y);
+  }
+  std::uint64_t key(Vec2 p) const {
+    return pack(static_cast<std::int64_t>(std::floor(p.x / cell_)), static_cast<std::int64_t>(std::floor(p.y / cell_)));
+  }
+  double cell_ = 1.0;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed_;
+};
+
+std::uint32_t held_partner_key(const World& w, const HeldContact& c) {
+  return (c.other & kBodySupport) ? static_partner_key(w.statics.segments[c.other & ~kBodySupport].owner) : c.other;
+}
+
+// Held bodies are judged again against what they touch now (their supports may have
+// gone); free slow bodies that their contacts can hold are held. Returns whether any
+// body changed. Bodies freed here follow their free path for the step.
+bool hold_pass(World& w, const StepContext& ctx) {
+  const std::size_t n = w.size();
+  double rmax = 0.0;
+  bool any = false;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (!w.alive(i)) continue;
+    rmax = std::max(rmax, w.radius[i]);
+    if (w.is_held(i) || (w.dynamic(i) && !w.supported(i))) any = true;
+  }
+  if (!any) return false;
+  thread_local NearGrid grid;
+  thread_local std::vector<std::uint32_t> near;
+  grid.build(w, std::max(2.0 * rmax, 1e-6 * w.length_scale) * (1.0 + 1e-6));
+  bool changed = false;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (!w.is_held(i)) continue;
+    unhold(w, i);
+    w.apath[i] = {};
+    grid.query(w.pos[i], near);
+    if (try_hold(w, i, ctx.dt, near)) {
+      for (const HeldContact& c : w.held) {
+        if (c.body == i) touch_contact(w, i, held_partner_key(w, c), ctx.t0);
+      }
+      continue;
+    }
+    w.apath[i] = w.acc[i];
+    changed = true;
+    w.released.clear();
+    collect_dependents(w, i);
+    for (std::uint32_t d : w.released) release_support(w, d);
+  }
+  if (changed) grid.build(w, std::max(2.0 * rmax, 1e-6 * w.length_scale) * (1.0 + 1e-6));
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (!w.dynamic(i)) continue;
+    // Free, or driven along its face (a face alone cannot hold it: a second may).
+    const bool driven = w.supported(i) && !w.on_body(i) && (w.apath[i].x != 0.0 || w.apath[i].y != 0.0);
+    if (w.supported(i) && !driven) continue;
+    grid.query(w.pos[i], near);
+    if (!try_hold(w, i, ctx.dt, near)) continue;
+    changed = true;
+    for (const HeldContact& c : w.held) {
+      if (c.body != i) continue;
+      if (c.other & kBodySupport) {
+        record_contact(w, i, kNone, &w.statics.segments[c.other & ~kBodySupport], ctx.t0, ctx.dt);
+      } else {
+        record_contact(w, i, c.other, nullptr, ctx.t0, ctx.dt);
+      }
+    }
+  }
+  return changed;
+}
+
 }  // namespace
 
 void apply_supports(World& w, const StepContext& ctx) {
+  w.step_dt = ctx.dt;
   const std::size_t n = w.size();
   for (std::uint32_t i = 0; i < n; ++i) {
     if (w.support[i] == kNone) {
@@ -176,7 +384,7 @@ void apply_supports(World& w, const StepContext& ctx) {
   for (bool changed = true; changed;) {
     changed = false;
     for (std::uint32_t i = 0; i < n; ++i) {
-      if (!w.on_body(i)) continue;
+      if (!w.on_body(i) || w.is_held(i)) continue;
       const std::uint32_t j = w.support[i] & ~kBodySupport;
       const Vec2 d = w.pos[i] - w.pos[j];
       const double dist = length(d);
@@ -195,6 +403,7 @@ void apply_supports(World& w, const StepContext& ctx) {
         changed = true;
       }
     }
+    if (hold_pass(w, ctx)) changed = true;
   }
 }
 

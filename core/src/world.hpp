@@ -29,6 +29,16 @@ const char* integrator_name(Integrator i);
 inline constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 // support[i] names a segment, or with this bit a body (a body at rest on a body).
 inline constexpr std::uint32_t kBodySupport = 0x80000000u;
+// support[i] == kHeld: at rest, held by several contacts at once (World::held). It has
+// the body bit, so on_body() and stuck() treat it as a body at rest on bodies.
+inline constexpr std::uint32_t kHeld = 0xFFFFFFFEu;
+
+// One contact of a held body: `other` is a body, or kBodySupport | segment index.
+struct HeldContact {
+  std::uint32_t body = 0;
+  std::uint32_t other = 0;
+  Vec2 n;   // unit, from the other towards the body
+};
 
 enum BodyFlag : std::uint8_t {
   kAlive = 1,
@@ -156,6 +166,7 @@ struct World {
   std::vector<Vec2> support_n;          // unit, from the support towards the body
   std::vector<std::uint32_t> dep_head, dep_next;   // any_forces: bodies resting on each body (a list)
   std::vector<std::uint32_t> released;             // scratch: bodies freed by their support moving
+  std::vector<HeldContact> held;                   // any_forces: the contacts of every held body
   // any_forces: contact continuity, per pair: contact_key(i, partner) -> the last time
   // the pair touched (an impact, or resting on each other at a step's end).
   std::unordered_map<std::uint64_t, double> last_touch;
@@ -214,6 +225,9 @@ struct World {
   bool dynamic(std::uint32_t i) const { return (flags[i] & (kAlive | kStatic)) == kAlive; }
   bool supported(std::uint32_t i) const { return !support.empty() && support[i] != kNone; }
   bool on_body(std::uint32_t i) const { return supported(i) && (support[i] & kBodySupport) != 0; }
+  bool is_held(std::uint32_t i) const { return !support.empty() && support[i] == kHeld; }
+  // Does not move for the rest of the step: static, or at rest on its supports.
+  bool stationary(std::uint32_t i) const { return is_static(i) || stuck(i); }
   // At rest on a support: not moving, and held there for the rest of the step.
   bool stuck(std::uint32_t i) const {
     return supported(i) && vel[i].x == 0.0 && vel[i].y == 0.0 && apath[i].x == 0.0 && apath[i].y == 0.0;
@@ -256,6 +270,14 @@ struct World {
   double rest_speed(double a_n, double dt) const {
     return rest_speed_option > 0.0 ? rest_speed_option : rest_factor * std::abs(a_n) * dt;
   }
+  // Inelastic collapse: an impact of bodies i and j closing slower than this is
+  // perfectly inelastic (restitution falls to 0): the rest speed of the larger of their
+  // accelerations. 0 in a scene without forces.
+  double step_dt = 0.0;   // the current step's dt (set by apply_supports)
+  double collapse_speed(std::uint32_t i, std::uint32_t j) const {
+    if (acc.empty() || step_dt == 0.0) return 0.0;
+    return rest_speed(std::max(length(acc[i]), length(acc[j])), step_dt);
+  }
   std::size_t memory_bytes() const;
 };
 
@@ -293,6 +315,16 @@ void rest_on_body(World& w, std::uint32_t i, std::uint32_t j, Vec2 n);
 bool can_rest_on(const World& w, std::uint32_t i, std::uint32_t j, Vec2 n, double rest_speed);
 // Appends the bodies resting on j, and on those in turn, to w.released.
 void collect_dependents(World& w, std::uint32_t j);
+// Several supports at once (resting_contact.cpp). Body i, slow (|v| <= the rest speed
+// of its acceleration), is held at rest if the stationary bodies and faces it touches
+// can balance its force: -a lies in the cone spanned by their normals widened by their
+// static friction cones. Then its velocity goes to 0, support[i] = kHeld and its
+// contacts are recorded. `near`: bodies that may touch it (others are ignored).
+bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near);
+// Forgets a held body's contacts and makes it free (its path: a = acc).
+void unhold(World& w, std::uint32_t i);
+// Appends the held bodies with a contact on body j to `out`.
+void held_on(const World& w, std::uint32_t j, std::vector<std::uint32_t>& out);
 // Time within the step at which a supported body stops sliding or leaves its
 // segment, from time t (toi::kNever if not in [t, T]).
 double support_stop_time(const World& w, std::uint32_t i, double t, double T);
@@ -314,6 +346,9 @@ ImpactResult resolve_pair(World& w, std::uint32_t i, std::uint32_t j, Vec2 n, co
 // them at once, leaves every body of the set advanced to t in `bodies` and the pairs
 // that took an impulse in `impacted`, returns true.
 // Otherwise (one contact, sequential law, friction, supports, rules) changes nothing.
+// j may also be kSimultaneousFace | k: body i's impact on face k of segment k; the set
+// then includes the faces its bodies touch, and `impacted` names a face the same way.
+inline constexpr std::uint32_t kSimultaneousFace = 0x80000000u;
 bool resolve_simultaneous(World& w, std::uint32_t i, std::uint32_t j, double t, std::vector<std::uint32_t>& bodies,
                           std::vector<BodyPair>& impacted);
 ImpactResult resolve_static(World& w, std::uint32_t i, Vec2 n, const PairMaterial& m,
