@@ -318,11 +318,25 @@ class EventLoop {
   // Body i (advanced to now) held at rest by the stationary bodies and faces it touches.
   bool hold(std::uint32_t i) {
     const double r = w_.radius[i];
-    const double pad = r + 1e-9 * (r + w_.length_scale);
+    const double pad = r + w_.rest_speed(length(w_.acc[i]), ctx_.dt) * ctx_.dt + 1e-9 * (r + w_.length_scale);
     const Vec2 p = w_.pos[i];
     near_.clear();
     w_.bp->query_box(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), i, near_);
-    return try_hold(w_, i, ctx_.dt, near_);
+    if (try_hold(w_, i, ctx_.dt, near_, true)) return true;
+    const double t = w_.tloc[i];
+    if (!try_hold_group(w_, i, t, ctx_.dt, [this](Vec2 q, double h, std::vector<std::uint32_t>& out) {
+          out.clear();
+          w_.bp->query_box(make_aabb(q.x - h, q.y - h, q.x + h, q.y + h), kNone, out);
+        }, group_)) {
+      return false;
+    }
+    // The other members' paths changed too (now at rest): new versions, no events.
+    for (std::uint32_t m : group_) {
+      if (m == i) continue;
+      ++w_.version[m];
+      reschedule(m, t);
+    }
+    return true;
   }
   // i, pressed slowly onto the stationary j, held at rest by j and its other contacts.
   bool hold_against(std::uint32_t i, std::uint32_t j) {
@@ -552,6 +566,7 @@ class EventLoop {
   std::vector<std::uint32_t> set_;      // the touching set of a simultaneous impact
   std::vector<BodyPair> impacted_;      // its pairs that took an impulse
   std::vector<std::uint32_t> near_;     // bodies near one being held
+  std::vector<std::uint32_t> group_;    // a group held at once
 };
 
 }  // namespace

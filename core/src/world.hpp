@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <unordered_map>
 #include <limits>
 #include <memory>
@@ -320,7 +321,19 @@ void collect_dependents(World& w, std::uint32_t j);
 // can balance its force: -a lies in the cone spanned by their normals widened by their
 // static friction cones. Then its velocity goes to 0, support[i] = kHeld and its
 // contacts are recorded. `near`: bodies that may touch it (others are ignored).
-bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near);
+// With settle_into_pocket, a body touching one support and within rest_speed x dt of a
+// second is also held where the two meet, if they hold it there (the limit of its
+// inelastic collapse into that pocket).
+bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near,
+              bool settle_into_pocket = false);
+// A group: the slow free bodies touching body `seed` at time t (within the step), and
+// those touching them, held at rest together if forces within their static friction
+// cones (normal forces >= 0) can hold every one of them still (an acceleration-level
+// contact problem, projected Gauss-Seidel). near_fn(p, pad, out) lists the bodies whose
+// boxes meet the square of half-side pad around p.
+using NearFn = std::function<void(Vec2, double, std::vector<std::uint32_t>&)>;
+bool try_hold_group(World& w, std::uint32_t seed, double t, double dt, const NearFn& near_fn,
+                    std::vector<std::uint32_t>& members);
 // Forgets a held body's contacts and makes it free (its path: a = acc).
 void unhold(World& w, std::uint32_t i);
 // Appends the held bodies with a contact on body j to `out`.
