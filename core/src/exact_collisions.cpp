@@ -100,7 +100,11 @@ class EventLoop {
         return;
       }
       ++ctx_.events;
-      if (getenv("PILE_DEBUG") && (ctx_.event_cap - ctx_.events < 30 || (ctx_.t0 > 9.0 && ctx_.t0 < 9.01 && ctx_.events < 60))) {
+      static const double dbg_t0 = getenv("PILE_T0") ? atof(getenv("PILE_T0")) : -1;
+      static const int dbg_b1 = getenv("PILE_B1") ? atoi(getenv("PILE_B1")) : -1;
+      static const int dbg_b2 = getenv("PILE_B2") ? atoi(getenv("PILE_B2")) : -1;
+      const bool dbg_hit = std::fabs(ctx_.t0 - dbg_t0) < 1e-6 && ((int)e.a == dbg_b1 || (int)e.a == dbg_b2 || ((int)e.b == dbg_b1 || (int)e.b == dbg_b2));
+      if (getenv("PILE_DEBUG") && (ctx_.event_cap - ctx_.events < 30 || dbg_hit)) {
         fprintf(stderr, "ev t=%.17g kind=%d a=%u b=%u feat=%d | va=(%g,%g) sup_a=%x", e.time, (int)e.kind(), e.a, e.b, (int)e.feature(), w_.vel_at(e.a, e.time).x, w_.vel_at(e.a, e.time).y, w_.support.empty()?0:w_.support[e.a]);
         if (e.kind() == EventKind::Pair) fprintf(stderr, " vb=(%g,%g) sup_b=%x gap=%g", w_.vel_at(e.b, e.time).x, w_.vel_at(e.b, e.time).y, w_.support[e.b], length(w_.pos_at(e.a, e.time) - w_.pos_at(e.b, e.time)) - w_.radius[e.a] - w_.radius[e.b]);
         fprintf(stderr, "\n");
