@@ -285,7 +285,7 @@ class EventLoop {
   // A body held on x is judged again without it: still held by its other contacts,
   // or free (and then whatever rested on it in turn).
   void free_dependents(std::uint32_t x, double t) {
-    if (w_.dep_head.empty()) return;
+    if (w_.dep_head.empty() || (w_.alive(x) && w_.stationary(x))) return;   // x did not move
     if (w_.dep_head[x] != kNone) {
       w_.released.clear();
       collect_dependents(w_, x);
@@ -433,7 +433,14 @@ class EventLoop {
       return;
     }
     if (!settled) {
-      resolve_pair(w_, i, j, n, m, min_sep);
+      const bool slow = -dot(w_.vel[j] - w_.vel[i], n) < w_.collapse_speed(i, j);
+      if (slow && w_.stationary(j) && !w_.stationary(i)) {
+        resolve_static(w_, i, -n, m, min_sep);   // its supports absorb a slow impact
+      } else if (slow && w_.stationary(i) && !w_.stationary(j)) {
+        resolve_static(w_, j, n, m, min_sep);
+      } else {
+        resolve_pair(w_, i, j, n, m, min_sep);
+      }
       after_velocity_change(i);
       after_velocity_change(j);
     }

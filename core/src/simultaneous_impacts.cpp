@@ -90,11 +90,19 @@ bool touching_face(const World& w, std::uint32_t i, std::uint32_t k, double t, C
   return true;
 }
 
-bool eligible_body(const World& w, std::uint32_t i) {
+// A body that can take part: a body at rest on its supports (held, or stuck on a face
+// or a body) only as a fixed one (`fixed_rest`: the impact is slower than the collapse
+// speed, so its supports absorb it); a body sliding on a face never.
+bool eligible_body(const World& w, std::uint32_t i, bool fixed_rest) {
   if (!w.alive(i)) return false;
   if (w.flags[i] & (kParticle | kPoint)) return false;
-  if (w.supported(i)) return false;
+  if (w.supported(i)) return fixed_rest && w.stationary(i);
   return true;
+}
+
+// Does not move in this impact: static, or at rest on its supports in a slow impact.
+bool fixed(const World& w, std::uint32_t i, bool fixed_rest) {
+  return w.is_static(i) || (fixed_rest && w.stationary(i));
 }
 
 }  // namespace
@@ -103,7 +111,14 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
                           std::vector<std::uint32_t>& bodies, std::vector<BodyPair>& impacted) {
   if (w.impact_law != ImpactLaw::Simultaneous || w.any_rules) return false;
   const bool face_seed = (j0 & kSegmentContact) != 0;
-  if (!eligible_body(w, i0) || (!face_seed && !eligible_body(w, j0))) return false;
+  // A slow seed impact (below the collapse speed) meets bodies at rest as fixed ones.
+  bool fixed_rest = false;
+  if (!w.acc.empty()) {
+    const Vec2 vj = face_seed ? Vec2{} : w.vel_at(j0, t);
+    fixed_rest = length(vj - w.vel_at(i0, t)) < w.collapse_speed(i0, face_seed ? i0 : j0);
+  }
+  if (!eligible_body(w, i0, fixed_rest) || (!face_seed && !eligible_body(w, j0, fixed_rest))) return false;
+  if (fixed(w, i0, fixed_rest) && (face_seed || fixed(w, j0, fixed_rest))) return false;
   // Scratch kept between calls: an isolated impact (the common case) allocates nothing.
   thread_local std::vector<Contact> contacts;
   thread_local std::vector<std::uint32_t> found;
@@ -127,8 +142,8 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   };
   // Adds contact (i, j) if the two touch; false if the set must go pair by pair.
   const auto consider = [&](std::uint32_t i, std::uint32_t j) {
-    if (j == i || !eligible_body(w, j)) return true;
-    if (w.is_static(i) && w.is_static(j)) return true;
+    if (j == i || !eligible_body(w, j, fixed_rest)) return true;
+    if (fixed(w, i, fixed_rest) && fixed(w, j, fixed_rest)) return true;
     Contact c;
     if (!touching(w, i, j, t, c)) return true;
     const bool known = std::any_of(contacts.begin(), contacts.end(),
@@ -143,7 +158,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   // The faces body i touches; false if one has interpolated normals (a surface: its own
   // response).
   const auto consider_faces = [&](std::uint32_t i) {
-    if (w.statics.segments.empty() || w.is_static(i)) return true;
+    if (w.statics.segments.empty() || fixed(w, i, fixed_rest)) return true;
     const Vec2 p = w.pos_at(i, t);
     const double pad = w.radius[i] * (1.0 + 1e-9) + kGapUlps * kEps * (inf_norm(p) + w.length_scale);
     w.found_static.clear();
@@ -181,8 +196,8 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     w.bp->query_box(merge(touch_box(first), touch_box(second)), kNone, found);
     std::sort(found.begin(), found.end());
     for (std::uint32_t j : found) {
-      if (!w.is_static(first) && !consider(first, j)) return false;
-      if (!w.is_static(second) && !consider(second, j)) return false;
+      if (!fixed(w, first, fixed_rest) && !consider(first, j)) return false;
+      if (!fixed(w, second, fixed_rest) && !consider(second, j)) return false;
     }
     // One contact so far and no faces: an isolated impact, the pairwise law's.
     if (!consider_faces(first) || !consider_faces(second)) return false;
@@ -190,7 +205,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   }
   for (; q < bodies.size(); ++q) {
     const std::uint32_t i = bodies[q];
-    if (w.is_static(i)) continue;
+    if (fixed(w, i, fixed_rest)) continue;
     found.clear();
     w.bp->query_box(touch_box(i), i, found);
     std::sort(found.begin(), found.end());
@@ -222,36 +237,45 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   }
   const std::size_t K = contacts.size();
   const std::size_t R = rows.size();
-  A.assign(R * R, 0.0);
   w0.assign(R, 0.0);
   p.assign(R, 0.0);
-  const auto inv = [&](std::uint32_t x) { return (x & kSegmentContact) ? 0.0 : w.inv_mass[x]; };
+  const auto inv = [&](std::uint32_t x) {
+    return (x & kSegmentContact) || fixed(w, x, fixed_rest) ? 0.0 : w.inv_mass[x];
+  };
   const auto vel = [&](std::uint32_t x) { return (x & kSegmentContact) ? Vec2{} : w.vel[x]; };
+  // Each row reads and writes its bodies' velocity changes (dv), so a sweep costs O(R),
+  // not O(R^2): slot[] maps a row's bodies into dv (faces: none).
+  thread_local std::vector<Vec2> dv;
+  thread_local std::vector<std::int32_t> slot_a, slot_b;
+  dv.assign(bodies.size(), Vec2{});
+  slot_a.assign(R, -1);
+  slot_b.assign(R, -1);
+  const auto slot_of = [&](std::uint32_t x) -> std::int32_t {
+    if (x & kSegmentContact) return -1;
+    return static_cast<std::int32_t>(std::find(bodies.begin(), bodies.end(), x) - bodies.begin());
+  };
+  A.assign(R, 0.0);   // the diagonal
   for (std::size_t k = 0; k < R; ++k) {
     const Row& rk = rows[k];
     w0[k] = dot(vel(rk.b) - vel(rk.a), rk.d);
-    for (std::size_t l = 0; l < R; ++l) {
-      const Row& rl = rows[l];
-      const double nn = dot(rk.d, rl.d);
-      double s = 0.0;
-      if (rk.a == rl.a) s += inv(rk.a) * nn;
-      if (rk.b == rl.b) s += inv(rk.b) * nn;
-      if (rk.a == rl.b) s -= inv(rk.a) * nn;
-      if (rk.b == rl.a) s -= inv(rk.b) * nn;
-      A[k * R + l] = s;
-    }
+    A[k] = inv(rk.a) + inv(rk.b);
+    slot_a[k] = slot_of(rk.a);
+    slot_b[k] = slot_of(rk.b);
   }
   // Projected Gauss-Seidel to round-off: normal impulses >= 0 reaching their targets,
   // tangential ones stopping the sliding within the static friction bound mu_s p_n.
+  // With friction the sweeps can trade round-off for ever: at most 2000 of them then.
+  const int max_iter = R > K ? 2000 : 100000;
   double pmax = 0.0;
-  for (int iter = 0; iter < 100000; ++iter) {
+  for (int iter = 0; iter < max_iter; ++iter) {
     double change = 0.0;
     for (std::size_t k = 0; k < R; ++k) {
-      const double akk = A[k * R + k];
+      const double akk = A[k];
       if (!(akk > 0.0)) continue;
-      double wk = w0[k];
-      for (std::size_t l = 0; l < R; ++l) wk += A[k * R + l] * p[l];
       const Row& rk = rows[k];
+      const Vec2 da = slot_a[k] >= 0 ? dv[static_cast<std::size_t>(slot_a[k])] : Vec2{};
+      const Vec2 db = slot_b[k] >= 0 ? dv[static_cast<std::size_t>(slot_b[k])] : Vec2{};
+      const double wk = w0[k] + dot(db - da, rk.d);
       double pk;
       if (rk.tangent) {
         const double bound = contacts[rk.contact].mu_s * p[k - 1];
@@ -259,7 +283,12 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       } else {
         pk = std::max(0.0, p[k] + (contacts[rk.contact].target - wk) / akk);
       }
-      change = std::max(change, std::fabs(pk - p[k]));
+      const double dp = pk - p[k];
+      if (dp != 0.0) {
+        if (slot_a[k] >= 0) dv[static_cast<std::size_t>(slot_a[k])] -= (dp * inv(rk.a)) * rk.d;
+        if (slot_b[k] >= 0) dv[static_cast<std::size_t>(slot_b[k])] += (dp * inv(rk.b)) * rk.d;
+      }
+      change = std::max(change, std::fabs(dp));
       p[k] = pk;
       pmax = std::max(pmax, std::fabs(pk));
     }
@@ -285,8 +314,8 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     // meets again at once through round-off, and takes an impulse of that size).
     if (c.p * (inv(c.a) + inv(c.b)) > kGapUlps * kEps * c.vscale) impacted.push_back({c.a, c.b});
     const Vec2 P = c.p * c.n + c.pt * perp(c.n);
-    if (!(c.a & kSegmentContact)) w.vel[c.a] -= w.inv_mass[c.a] * P;
-    w.vel[c.b] += w.inv_mass[c.b] * P;
+    if (!(c.a & kSegmentContact)) w.vel[c.a] -= inv(c.a) * P;
+    w.vel[c.b] += inv(c.b) * P;
   }
   w.stats.impacts += static_cast<std::int64_t>(K) - 1;
   return true;
