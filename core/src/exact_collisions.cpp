@@ -342,6 +342,14 @@ class EventLoop {
     }
     return true;
   }
+  bool force_hold(std::uint32_t i) {
+    const double r = w_.radius[i];
+    const double pad = r + 1e-9 * (r + w_.length_scale);
+    const Vec2 p = w_.pos[i];
+    near_.clear();
+    w_.bp->query_box(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), i, near_);
+    return hold_wedged(w_, i, ctx_.dt, near_);
+  }
   // i, pressed slowly onto the stationary j, held at rest by j and its other contacts.
   bool hold_against(std::uint32_t i, std::uint32_t j) {
     if (w_.stationary(i) || !w_.stationary(j)) return false;
@@ -428,7 +436,18 @@ class EventLoop {
         }
       }
     }
-    if (!settled && min_sep == 0.0 && resolve_simultaneous(w_, i, j, t, set_, impacted_)) {
+    const Vec2 vi_before = w_.vel[i], vj_before = w_.vel[j];
+    // A pressed, slow body that the impulses leave exactly as it was would meet the same
+    // impact at the same instant for ever: wedged, it is held where it is.
+    const auto wedged = [&]() {
+      if (min_sep == 0.0 || !(w_.vel[i] == vi_before) || !(w_.vel[j] == vj_before)) return false;
+      for (std::uint32_t x : {i, j}) {
+        if (!w_.stationary(x) && force_hold(x)) return true;
+      }
+      return false;
+    };
+    if (!settled && resolve_simultaneous(w_, i, j, t, set_, impacted_, min_sep)) {
+      if (wedged()) ++w_.stats.wedged;
       finish_simultaneous(t, t_abs);
       return;
     }
@@ -441,8 +460,12 @@ class EventLoop {
       } else {
         resolve_pair(w_, i, j, n, m, min_sep);
       }
-      after_velocity_change(i);
-      after_velocity_change(j);
+      if (wedged()) {
+        ++w_.stats.wedged;
+      } else {
+        after_velocity_change(i);
+        after_velocity_change(j);
+      }
     }
     if (r.event) record_contact(w_, i, j, nullptr, t_abs, ctx_.dt);
     ++w_.version[i];

@@ -520,6 +520,25 @@ bool try_hold_group(World& w, std::uint32_t seed, double t, double dt, const Nea
   return true;
 }
 
+bool hold_wedged(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near) {
+  if (!w.dynamic(i) || w.is_held(i) || w.acc.empty()) return false;
+  const double amag = length(w.acc[i]);
+  if (!(amag > 0.0) || length(w.vel[i]) > w.rest_speed(amag, dt)) return false;
+  thread_local std::vector<HeldContact> contacts;
+  thread_local std::vector<double> mu;
+  contacts.clear();
+  mu.clear();
+  touching_supports(w, i, near, contacts, mu);
+  if (contacts.empty()) return false;
+  release_support(w, i);
+  w.vel[i] = {};
+  w.apath[i] = {};
+  w.support[i] = kHeld;
+  w.support_n[i] = (-1.0 / amag) * w.acc[i];
+  w.held.insert(w.held.end(), contacts.begin(), contacts.end());
+  return true;
+}
+
 void unhold(World& w, std::uint32_t i) { release_support(w, i); }
 
 void held_on(const World& w, std::uint32_t j, std::vector<std::uint32_t>& out) {

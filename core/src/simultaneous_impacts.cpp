@@ -108,7 +108,7 @@ bool fixed(const World& w, std::uint32_t i, bool fixed_rest) {
 }  // namespace
 
 bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t,
-                          std::vector<std::uint32_t>& bodies, std::vector<BodyPair>& impacted) {
+                          std::vector<std::uint32_t>& bodies, std::vector<BodyPair>& impacted, double seed_min_sep) {
   if (w.impact_law != ImpactLaw::Simultaneous || w.any_rules) return false;
   const bool face_seed = (j0 & kSegmentContact) != 0;
   // A slow seed impact (below the collapse speed) meets bodies at rest as fixed ones.
@@ -138,6 +138,8 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     const std::uint32_t other = (c.a & kSegmentContact) ? c.b : c.a;
     const double e = -wn < w.collapse_speed(other, c.b) ? 0.0 : restitution;
     c.target = std::max(-e * wn, 0.0);
+    const bool seed = face_seed ? (c.a == j0 && c.b == i0) : (c.a == std::min(i0, j0) && c.b == std::max(i0, j0));
+    if (seed) c.target = std::max(c.target, seed_min_sep);
     contacts.push_back(c);
   };
   // Adds contact (i, j) if the two touch; false if the set must go pair by pair.

@@ -334,6 +334,10 @@ bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_
 using NearFn = std::function<void(Vec2, double, std::vector<std::uint32_t>&)>;
 bool try_hold_group(World& w, std::uint32_t seed, double t, double dt, const NearFn& near_fn,
                     std::vector<std::uint32_t>& members);
+// A slow body wedged among stationary bodies and faces (no impulse moves it, so the
+// same impact would recur at the same instant for ever) is held where it is, whether
+// or not its contacts balance its force exactly; the next step judges it again.
+bool hold_wedged(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near);
 // Forgets a held body's contacts and makes it free (its path: a = acc).
 void unhold(World& w, std::uint32_t i);
 // Appends the held bodies with a contact on body j to `out`.
@@ -362,8 +366,9 @@ ImpactResult resolve_pair(World& w, std::uint32_t i, std::uint32_t j, Vec2 n, co
 // j may also be kSimultaneousFace | k: body i's impact on face k of segment k; the set
 // then includes the faces its bodies touch, and `impacted` names a face the same way.
 inline constexpr std::uint32_t kSimultaneousFace = 0x80000000u;
+// seed_min_sep: the pair (i, j) leaves at least this fast (a micro-bounce).
 bool resolve_simultaneous(World& w, std::uint32_t i, std::uint32_t j, double t, std::vector<std::uint32_t>& bodies,
-                          std::vector<BodyPair>& impacted);
+                          std::vector<BodyPair>& impacted, double seed_min_sep = 0.0);
 ImpactResult resolve_static(World& w, std::uint32_t i, Vec2 n, const PairMaterial& m,
                             double min_separation_speed);
 // Records a contact event if the contact begins (see exact_collisions.cpp) at absolute

@@ -31,6 +31,7 @@ struct CoreStepStats {
   std::int64_t events = 0;          // events processed (impacts, friction stops, leaving a support, ...)
   std::int64_t candidate_pairs = 0; // broad-phase pairs at the start of the step
   bool event_cap_hit = false;       // the step ended in the lecture pass (see max_events_per_step)
+  std::int64_t wedged = 0;          // slow bodies held where no impulse could move them
 };
 
 // The core engine. Construct it through core_engine_factory() or directly (tests).
