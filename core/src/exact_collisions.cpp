@@ -15,8 +15,6 @@
 // step is finished with the lecture pass (reported in limits_hit).
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "physval/core/time_of_impact.hpp"
 #include "world.hpp"
@@ -100,15 +98,6 @@ class EventLoop {
         return;
       }
       ++ctx_.events;
-      static const double dbg_t0 = getenv("PILE_T0") ? atof(getenv("PILE_T0")) : -1;
-      static const int dbg_b1 = getenv("PILE_B1") ? atoi(getenv("PILE_B1")) : -1;
-      static const int dbg_b2 = getenv("PILE_B2") ? atoi(getenv("PILE_B2")) : -1;
-      const bool dbg_hit = std::fabs(ctx_.t0 - dbg_t0) < 1e-6 && ((int)e.a == dbg_b1 || (int)e.a == dbg_b2 || ((int)e.b == dbg_b1 || (int)e.b == dbg_b2));
-      if (getenv("PILE_DEBUG") && (ctx_.event_cap - ctx_.events < 30 || dbg_hit)) {
-        fprintf(stderr, "ev t=%.17g kind=%d a=%u b=%u feat=%d | va=(%g,%g) sup_a=%x", e.time, (int)e.kind(), e.a, e.b, (int)e.feature(), w_.vel_at(e.a, e.time).x, w_.vel_at(e.a, e.time).y, w_.support.empty()?0:w_.support[e.a]);
-        if (e.kind() == EventKind::Pair) fprintf(stderr, " vb=(%g,%g) sup_b=%x gap=%g", w_.vel_at(e.b, e.time).x, w_.vel_at(e.b, e.time).y, w_.support[e.b], length(w_.pos_at(e.a, e.time) - w_.pos_at(e.b, e.time)) - w_.radius[e.a] - w_.radius[e.b]);
-        fprintf(stderr, "\n");
-      }
       process(e);
     }
   }
@@ -437,10 +426,23 @@ class EventLoop {
       }
     }
     const Vec2 vi_before = w_.vel[i], vj_before = w_.vel[j];
+    // Impacts of each body at this very instant: a slow body met again and again at one
+    // instant (a cycle of impacts among wedged bodies) is wedged too.
+    if (t != instant_) {
+      for (std::uint32_t x : counted_) same_instant_[x] = 0;
+      counted_.clear();
+      instant_ = t;
+    }
+    if (same_instant_.size() < w_.size()) same_instant_.resize(w_.size(), 0);
+    for (std::uint32_t x : {i, j}) {
+      if (same_instant_[x]++ == 0) counted_.push_back(x);
+    }
+    const bool cycling = same_instant_[i] > kCycle || same_instant_[j] > kCycle;
     // A pressed, slow body that the impulses leave exactly as it was would meet the same
     // impact at the same instant for ever: wedged, it is held where it is.
     const auto wedged = [&]() {
-      if (min_sep == 0.0 || !(w_.vel[i] == vi_before) || !(w_.vel[j] == vj_before)) return false;
+      const bool unchanged = w_.vel[i] == vi_before && w_.vel[j] == vj_before;
+      if (!(min_sep > 0.0 && unchanged) && !cycling) return false;
       for (std::uint32_t x : {i, j}) {
         if (!w_.stationary(x) && force_hold(x)) return true;
       }
@@ -601,6 +603,10 @@ class EventLoop {
   std::vector<BodyPair> impacted_;      // its pairs that took an impulse
   std::vector<std::uint32_t> near_;     // bodies near one being held
   std::vector<std::uint32_t> group_;    // a group held at once
+  static constexpr std::uint32_t kCycle = 64;
+  double instant_ = -1.0;                      // the time of the last pair impact
+  std::vector<std::uint32_t> same_instant_;    // per body: its impacts at that time
+  std::vector<std::uint32_t> counted_;         // bodies with a count to reset
 };
 
 }  // namespace
