@@ -539,6 +539,52 @@ bool hold_wedged(World& w, std::uint32_t i, double dt, std::span<const std::uint
   return true;
 }
 
+std::vector<RestingContact> resting_contacts(const World& w) {
+  std::vector<RestingContact> out;
+  if (w.support.empty()) return out;
+  const std::size_t n = w.size();
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (!w.alive(i) || !w.stuck(i) || w.is_held(i)) continue;
+    out.push_back({i, w.on_body(i) ? (w.support[i] & ~kBodySupport) : (kBodySupport | w.support[i]), w.support_n[i], 0.0});
+  }
+  for (const HeldContact& c : w.held) {
+    // A pair of held bodies appears once per body: keep the one from the larger index.
+    if (!(c.other & kBodySupport) && w.is_held(c.other) && c.other > c.body) continue;
+    out.push_back({c.body, c.other, c.n, 0.0});
+  }
+  // Accelerations of the bodies at rest under their forces and the contact forces.
+  std::vector<Vec2> acc(n);
+  std::vector<std::uint8_t> rest(n, 0);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (w.alive(i) && w.stuck(i)) {
+      rest[i] = 1;
+      acc[i] = w.acc[i];
+    }
+  }
+  const auto moving = [&](std::uint32_t x) { return !(x & kBodySupport) && x < n && rest[x]; };
+  const auto inv = [&](std::uint32_t x) { return moving(x) ? w.inv_mass[x] : 0.0; };
+  double amax = 0.0;
+  for (std::uint32_t i = 0; i < n; ++i) amax = std::max(amax, length(acc[i]));
+  for (int iter = 0; iter < 200000; ++iter) {
+    double change = 0.0;
+    for (RestingContact& c : out) {
+      const double akk = inv(c.body) + inv(c.other);
+      if (!(akk > 0.0)) continue;
+      const Vec2 ao = moving(c.other) ? acc[c.other] : Vec2{};
+      const double wk = dot(acc[c.body] - ao, c.n);
+      const double f = std::max(0.0, c.force - wk / akk);
+      const double df = f - c.force;
+      if (df == 0.0) continue;
+      c.force = f;
+      acc[c.body] += (df * inv(c.body)) * c.n;
+      if (moving(c.other)) acc[c.other] -= (df * inv(c.other)) * c.n;
+      change = std::max(change, std::fabs(df) * akk);
+    }
+    if (change <= 1e-15 * amax) break;
+  }
+  return out;
+}
+
 void unhold(World& w, std::uint32_t i) { release_support(w, i); }
 
 void held_on(const World& w, std::uint32_t j, std::vector<std::uint32_t>& out) {

@@ -338,6 +338,16 @@ bool try_hold_group(World& w, std::uint32_t seed, double t, double dt, const Nea
 // same impact would recur at the same instant for ever) is held where it is, whether
 // or not its contacts balance its force exactly; the next step judges it again.
 bool hold_wedged(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near);
+// The contacts of all bodies at rest (held, or stuck on a face or a body) with their
+// normal forces from the equilibrium of all at once (frictionless normal forces >= 0,
+// projected Gauss-Seidel to round-off).
+struct RestingContact {
+  std::uint32_t body = 0;
+  std::uint32_t other = 0;   // a body, or kBodySupport | segment
+  Vec2 n;                    // towards body
+  double force = 0.0;
+};
+std::vector<RestingContact> resting_contacts(const World& w);
 // Forgets a held body's contacts and makes it free (its path: a = acc).
 void unhold(World& w, std::uint32_t i);
 // Appends the held bodies with a contact on body j to `out`.
