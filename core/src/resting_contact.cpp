@@ -672,7 +672,7 @@ bool hold_pass(World& w, const StepContext& ctx) {
   for (std::uint32_t i = 0; i < n; ++i) {
     if (!w.alive(i)) continue;
     rmax = std::max(rmax, w.radius[i]);
-    if (w.is_held(i) || (w.dynamic(i) && !w.supported(i))) any = true;
+    if (w.is_held(i) || (w.dynamic(i) && (!w.supported(i) || !w.stuck(i)))) any = true;
   }
   if (!any) return false;
   thread_local NearGrid grid;

@@ -91,12 +91,12 @@ bool touching_face(const World& w, std::uint32_t i, std::uint32_t k, double t, C
 }
 
 // A body that can take part: a body at rest on its supports (held, or stuck on a face
-// or a body) only as a fixed one (`fixed_rest`: the impact is slower than the collapse
-// speed, so its supports absorb it); a body sliding on a face never.
+// or a body) too, with its faces (fixed when `fixed_rest`: the impact is slower than the
+// collapse speed, so its supports absorb it); a body sliding on a face never.
 bool eligible_body(const World& w, std::uint32_t i, bool fixed_rest) {
   if (!w.alive(i)) return false;
   if (w.flags[i] & (kParticle | kPoint)) return false;
-  if (w.supported(i)) return fixed_rest && w.stationary(i);
+  if (w.supported(i)) return w.stationary(i);
   return true;
 }
 
@@ -185,6 +185,9 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     const double pad = kGapUlps * kEps * (inf_norm(p) + 2.0 * w.radius[i] + 1.0) + w.radius[i];
     return make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad);
   };
+  // A body at rest on its supports takes part with its faces only: the set does not
+  // spread through a pile at rest (its other contacts meet it pair by pair if it moves).
+  const auto leaf = [&](std::uint32_t i) { return w.supported(i) && w.stationary(i) && !fixed(w, i, fixed_rest); };
   // The impacting pair first, with one broad-phase query for both (an isolated impact,
   // the common case, pays only this); then breadth-first over the rest of the set.
   // Static bodies end the set (nothing moves them).
@@ -198,8 +201,8 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     w.bp->query_box(merge(touch_box(first), touch_box(second)), kNone, found);
     std::sort(found.begin(), found.end());
     for (std::uint32_t j : found) {
-      if (!fixed(w, first, fixed_rest) && !consider(first, j)) return false;
-      if (!fixed(w, second, fixed_rest) && !consider(second, j)) return false;
+      if (!fixed(w, first, fixed_rest) && !leaf(first) && !consider(first, j)) return false;
+      if (!fixed(w, second, fixed_rest) && !leaf(second) && !consider(second, j)) return false;
     }
     // One contact so far and no faces: an isolated impact, the pairwise law's.
     if (!consider_faces(first) || !consider_faces(second)) return false;
@@ -208,6 +211,10 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   for (; q < bodies.size(); ++q) {
     const std::uint32_t i = bodies[q];
     if (fixed(w, i, fixed_rest)) continue;
+    if (leaf(i)) {
+      if (!consider_faces(i)) return false;
+      continue;
+    }
     found.clear();
     w.bp->query_box(touch_box(i), i, found);
     std::sort(found.begin(), found.end());
@@ -267,7 +274,9 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   // Projected Gauss-Seidel to round-off: normal impulses >= 0 reaching their targets,
   // tangential ones stopping the sliding within the static friction bound mu_s p_n.
   // With friction the sweeps can trade round-off for ever: at most 2000 of them then.
-  const int max_iter = R > K ? 2000 : 100000;
+  const bool friction = R > K;
+  const int max_iter = friction ? 2000 : 100000;
+  const double stop = 4.0 * kEps;
   double pmax = 0.0;
   for (int iter = 0; iter < max_iter; ++iter) {
     double change = 0.0;
@@ -294,7 +303,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       p[k] = pk;
       pmax = std::max(pmax, std::fabs(pk));
     }
-    if (change <= 4.0 * kEps * pmax) break;
+    if (change <= stop * pmax) break;
   }
   // A contact whose friction could not stop it slides: kinetic friction, mu_k p_n.
   for (std::size_t k = 0; k < R; ++k) {

@@ -145,7 +145,7 @@ TEST(CorePile, ColumnOfCirclesEachContactCarriesTheWeightAbove) {
     ASSERT_EQ(sim.engine.last_step_stats().events, 0) << k;
   }
   for (int k = 0; k < 10; ++k) {
-    EXPECT_EQ(sim.state("c" + std::to_string(k)).position, Vec2{0.0, r + 2.0 * r * k});
+    EXPECT_EQ(sim.state("c" + std::to_string(k)).position, (Vec2{0.0, r + 2.0 * r * k}));
   }
   const auto forces = sim.engine.resting_forces();
   for (int k = 0; k < 10; ++k) {
@@ -177,9 +177,9 @@ TEST(CorePile, StackAtMassRatiosUpTo1e9Holds) {
         sim.step(dt);
         ASSERT_EQ(sim.engine.last_step_stats().events, 0) << k;
       }
-      EXPECT_EQ(sim.state("a").position, Vec2{0.0, 0.5});
-      EXPECT_EQ(sim.state("b").position, Vec2{0.0, 1.5});
-      EXPECT_EQ(sim.state("c").position, Vec2{0.0, 2.5});
+      EXPECT_EQ(sim.state("a").position, (Vec2{0.0, 0.5}));
+      EXPECT_EQ(sim.state("b").position, (Vec2{0.0, 1.5}));
+      EXPECT_EQ(sim.state("c").position, (Vec2{0.0, 2.5}));
     }
   }
 }
