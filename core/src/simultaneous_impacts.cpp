@@ -271,6 +271,78 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     slot_a[k] = slot_of(rk.a);
     slot_b[k] = slot_of(rk.b);
   }
+  const auto solve_exactly = [&](const auto& rws, const auto& cts, const std::vector<double>& w00,
+                                 std::vector<double>& pp, const auto& invf) {
+    const std::size_t n = rws.size();
+    double M[6][6];
+    for (std::size_t k = 0; k < n; ++k) {
+      for (std::size_t l = 0; l < n; ++l) {
+        const double nn = dot(rws[k].d, rws[l].d);
+        double v = 0.0;
+        if (rws[k].a == rws[l].a) v += invf(rws[k].a) * nn;
+        if (rws[k].b == rws[l].b) v += invf(rws[k].b) * nn;
+        if (rws[k].a == rws[l].b) v -= invf(rws[k].a) * nn;
+        if (rws[k].b == rws[l].a) v -= invf(rws[k].b) * nn;
+        M[k][l] = v;
+      }
+    }
+    std::vector<unsigned> order;
+    for (unsigned m = 1; m < (1u << n); ++m) order.push_back(m);
+    std::stable_sort(order.begin(), order.end(),
+                     [](unsigned x, unsigned y) { return __builtin_popcount(x) > __builtin_popcount(y); });
+    for (unsigned mask : order) {
+      std::size_t idx[6], m = 0;
+      for (std::size_t k = 0; k < n; ++k) {
+        if (mask & (1u << k)) idx[m++] = k;
+      }
+      double G[6][7];
+      for (std::size_t r = 0; r < m; ++r) {
+        for (std::size_t c = 0; c < m; ++c) G[r][c] = M[idx[r]][idx[c]];
+        G[r][m] = cts[rws[idx[r]].contact].target - w00[idx[r]];
+      }
+      bool singular = false;
+      for (std::size_t c = 0; c < m && !singular; ++c) {
+        std::size_t piv = c;
+        for (std::size_t r = c + 1; r < m; ++r) {
+          if (std::fabs(G[r][c]) > std::fabs(G[piv][c])) piv = r;
+        }
+        if (!(std::fabs(G[piv][c]) > 1e-300)) {
+          singular = true;
+          break;
+        }
+        for (std::size_t q = 0; q <= m; ++q) std::swap(G[c][q], G[piv][q]);
+        for (std::size_t r = 0; r < m; ++r) {
+          if (r == c) continue;
+          const double f = G[r][c] / G[c][c];
+          for (std::size_t q = c; q <= m; ++q) G[r][q] -= f * G[c][q];
+        }
+      }
+      if (singular) continue;
+      double x[6] = {0, 0, 0, 0, 0, 0};
+      bool ok = true;
+      for (std::size_t r = 0; r < m; ++r) {
+        x[idx[r]] = G[r][m] / G[r][r];
+        if (x[idx[r]] < 0.0) ok = false;
+      }
+      if (!ok) continue;
+      for (std::size_t k = 0; k < n && ok; ++k) {
+        if (mask & (1u << k)) continue;
+        double wk = w00[k];
+        for (std::size_t l = 0; l < n; ++l) wk += M[k][l] * x[l];
+        const double scale = std::fabs(w00[k]) + std::fabs(cts[rws[k].contact].target) + 1e-300;
+        if (wk < cts[rws[k].contact].target - kGapUlps * kEps * scale) ok = false;
+      }
+      if (!ok) continue;
+      for (std::size_t k = 0; k < n; ++k) pp[k] = x[k];
+      return true;
+    }
+    return false;
+  };
+  // A small frictionless set is solved exactly: the first complementary active set
+  // (largest first) whose impulses are >= 0 and whose other contacts separate. PGS
+  // would crawl when masses differ by 1e9 (its rate is 1 - m_light / m_heavy).
+  bool solved = false;
+  if (R == K && K <= 6) solved = solve_exactly(rows, contacts, w0, p, inv);
   // Projected Gauss-Seidel to round-off: normal impulses >= 0 reaching their targets,
   // tangential ones stopping the sliding within the static friction bound mu_s p_n.
   // With friction the sweeps can trade round-off for ever: at most 2000 of them then.
@@ -278,7 +350,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   const int max_iter = friction ? 2000 : 100000;
   const double stop = 4.0 * kEps;
   double pmax = 0.0;
-  for (int iter = 0; iter < max_iter; ++iter) {
+  for (int iter = 0; iter < max_iter && !solved; ++iter) {
     double change = 0.0;
     for (std::size_t k = 0; k < R; ++k) {
       const double akk = A[k];
