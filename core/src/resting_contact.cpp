@@ -702,8 +702,10 @@ bool hold_pass(World& w, const StepContext& ctx) {
   if (changed) grid.build(w, std::max(2.0 * rmax, 1e-6 * w.length_scale) * (1.0 + 1e-6));
   for (std::uint32_t i = 0; i < n; ++i) {
     if (!w.dynamic(i)) continue;
-    // Free, or driven along its face (a face alone cannot hold it: a second may).
-    const bool driven = w.supported(i) && !w.on_body(i) && (w.apath[i].x != 0.0 || w.apath[i].y != 0.0);
+    // Free, or at rest on its face and driven along it (the face alone cannot hold it: a
+    // second may). A body sliding on its face keeps sliding to its exact stop event.
+    const bool driven = w.supported(i) && !w.on_body(i) && w.vel[i] == Vec2{} &&
+                        (w.apath[i].x != 0.0 || w.apath[i].y != 0.0);
     if (w.supported(i) && !driven) continue;
     grid.query(w.pos[i], near);
     if (!try_hold(w, i, ctx.dt, near)) continue;

@@ -228,7 +228,9 @@ TEST_P(CorePileSettles, SettlesWithoutOverlapCapOrEnergyGain) {
     ASSERT_LE(E, E_prev + 1e-12 * std::fabs(E_prev) + micro_bounces) << "step " << k;
     ASSERT_LE(E, E0 + 1e-12 * std::fabs(E0)) << "step " << k;
     E_prev = E;
-    if (k % 30 == 29) ASSERT_LE(deepest_overlap(sim.states, sim.scene), 1e-9) << "step " << k;
+    if (k % 30 == 29) {
+      ASSERT_LE(deepest_overlap(sim.states, sim.scene), 1e-9) << "step " << k;
+    }
     last_events = sim.engine.last_step_stats().events;
   }
   EXPECT_LE(deepest_overlap(sim.states, sim.scene), 1e-9);
@@ -243,10 +245,10 @@ INSTANTIATE_TEST_SUITE_P(Piles, CorePileSettles,
                                            PileCase{50, 0.3, 1}, PileCase{50, 0.0, 2}, PileCase{50, 0.9, 3},
                                            PileCase{50, 0.5, 4}, PileCase{100, 0.3, 5}, PileCase{100, 0.6, 6},
                                            PileCase{200, 0.3, 7}),
-                         [](const auto& info) {
-                           return "n" + std::to_string(info.param.n) + "_e" +
-                                  std::to_string(static_cast<int>(info.param.e * 10)) + "_seed" +
-                                  std::to_string(info.param.seed);
+                         [](const auto& test_info) {
+                           return "n" + std::to_string(test_info.param.n) + "_e" +
+                                  std::to_string(static_cast<int>(test_info.param.e * 10)) + "_seed" +
+                                  std::to_string(test_info.param.seed);
                          });
 
 }  // namespace physval::test
