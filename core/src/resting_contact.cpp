@@ -277,7 +277,7 @@ void near_supports(World& w, std::uint32_t i, std::span<const std::uint32_t> nea
 bool clear_of_everything(World& w, std::uint32_t i, std::span<const std::uint32_t> near) {
   const double r = w.radius[i];
   const Vec2 p = w.pos[i];
-  const double tol = 1e-9 * (r + w.length_scale);
+  const double tol = 1e-12 * (r + w.length_scale);   // round-off only: it must not overlap
   if (!w.statics.segments.empty()) {
     w.found_static.clear();
     w.statics.query(make_aabb(p.x - r - tol, p.y - r - tol, p.x + r + tol, p.y + r + tol), w.found_static);
@@ -297,7 +297,7 @@ bool clear_of_everything(World& w, std::uint32_t i, std::span<const std::uint32_
     if (j == i || !w.alive(j)) continue;
     if ((w.flags[i] & kPoint) && (w.flags[j] & kPoint)) continue;
     const double R = r + w.radius[j];
-    if (length(p - w.pos_at(j, w.tloc[i])) < R - 1e-9 * (R + w.length_scale)) return false;
+    if (length(p - w.pos_at(j, w.tloc[i])) < R - 1e-12 * (R + w.length_scale)) return false;
   }
   return true;
 }
