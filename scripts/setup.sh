@@ -4,10 +4,10 @@
 set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
-  libbox2d-dev libbullet-dev libeigen3-dev
+  libbox2d-dev libbullet-dev libeigen3-dev libchipmunk-dev libode-dev
   libtomlplusplus-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libbenchmark-dev
-  gnuplot-nox
+  gnuplot-nox zlib1g-dev chromium
   python3
   clang-14 libclang-rt-14-dev
 )

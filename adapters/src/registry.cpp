@@ -8,6 +8,12 @@
 #include "physval/adapters/bullet_adapter.hpp"
 #include "physval/adapters/plugin_engine.hpp"
 #include "physval/core/core_engine.hpp"
+#ifdef PHYSVAL_HAVE_CHIPMUNK
+#include "physval/adapters/chipmunk_adapter.hpp"
+#endif
+#ifdef PHYSVAL_HAVE_ODE
+#include "physval/adapters/ode_adapter.hpp"
+#endif
 
 namespace physval {
 
@@ -16,6 +22,13 @@ namespace {
 std::vector<EngineFactory>& mutable_registry() {
   static std::vector<EngineFactory> engines = [] {
     std::vector<EngineFactory> all = {core_engine_factory(), box2d_engine_factory(), bullet_engine_factory()};
+    // Optional engines, built when their Debian packages are found (adapters/CMakeLists.txt).
+#ifdef PHYSVAL_HAVE_CHIPMUNK
+    all.push_back(chipmunk_engine_factory());
+#endif
+#ifdef PHYSVAL_HAVE_ODE
+    all.push_back(ode_engine_factory());
+#endif
     // core, run with RK4 and event-driven impacts, is the reference.
     all[0].reference_options = {{"integrator", std::string("rk4")}, {"collision", std::string("exact")}};
     // The bundled plugins follow, as if built in (a broken one throws PluginError here,

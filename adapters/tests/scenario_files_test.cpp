@@ -84,7 +84,18 @@ TEST_P(ScenarioFiles, EveryBuiltInScenarioLoadsOrIsUnsupportedByName) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Adapters, ScenarioFiles, ::testing::Values("box2d", "bullet"),
+std::vector<std::string> adapter_names() {
+  std::vector<std::string> all = {"box2d", "bullet"};
+#ifdef PHYSVAL_HAVE_CHIPMUNK
+  all.push_back("chipmunk");   // built in when its Debian package was found
+#endif
+#ifdef PHYSVAL_HAVE_ODE
+  all.push_back("ode");
+#endif
+  return all;
+}
+
+INSTANTIATE_TEST_SUITE_P(Adapters, ScenarioFiles, ::testing::ValuesIn(adapter_names()),
                          [](const ::testing::TestParamInfo<std::string>& i) { return i.param; });
 
 }  // namespace

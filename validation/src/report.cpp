@@ -21,6 +21,7 @@
 #include "physval/validation/results_json.hpp"
 #include "markup_escape.hpp"
 #include "report_figures.hpp"
+#include "report_player.hpp"
 
 namespace physval {
 
@@ -100,11 +101,11 @@ std::string checks_html(const json& run) {
     }
     std::string line = html(str(c, "what"));
     if (auto v = num(c, "value")) {
-      line += " " + fmt(*v);
+      line.append(" ").append(fmt(*v));
     } else {
       line += " (not measured)";
     }
-    if (auto l = num(c, "limit")) line += " &gt; " + fmt(*l);
+    if (auto l = num(c, "limit")) line.append(" &gt; ").append(fmt(*l));
     if (!is_enforced) line += " <span class=grey>(gate, not enforced)</span>";
     failures += "<br>" + line;
   }
@@ -123,6 +124,8 @@ std::string metrics_table(const ScenarioView& v) {
   os << "<table><tr><th>engine</th><th>status</th><th>energy drift</th><th>momentum drift</th>"
         "<th>angular momentum drift</th><th>energy divergence</th><th>momentum divergence</th>"
         "<th>position divergence</th><th>first contact</th><th>contact time error</th><th>missed / extra contacts</th>"
+        "<th title=\"deepest overlap of a body with another body or a barrier\">max penetration</th>"
+        "<th title=\"bodies that left the region the scene's barriers enclose\">escaped bodies</th>"
         "<th>wall time</th><th>checks</th></tr>\n";
   for (const json* run : v.runs) {
     const json& m = member(*run, "metrics");
@@ -144,6 +147,13 @@ std::string metrics_table(const ScenarioView& v) {
          << "</td>";
     } else {
       os << "<td class=na>&ndash;</td>";
+    }
+    os << metric_cell(m, "max_penetration", " m");
+    if (auto escaped = num(m, "escaped_bodies")) {
+      os << "<td class=num" << (*escaped > 0.0 ? " style=\"color:#b3261e;font-weight:600\"" : "") << ">"
+         << fmt(*escaped, "%.0f") << "</td>";
+    } else {
+      os << "<td class=na title=\"does not apply or not measured\">&ndash;</td>";
     }
     if (auto w = num(*run, "wall_seconds"); w && status != "unsupported") {
       os << "<td class=num>" << fmt(*w) << " s</td>";
@@ -287,6 +297,14 @@ void write_report(const fs::path& dir, const Progress& progress) {
 
   for (ScenarioView& v : views) {
     const fs::path series_dir = dir / "series" / report_file_name(v.name);
+    if (std::ifstream geometry(series_dir / "scene.json"); geometry) {
+      try {
+        geometry >> v.geometry;
+      } catch (const std::exception&) {
+        v.geometry = nullptr;   // drawn without barriers rather than not at all
+        notes.push_back((series_dir / "scene.json").string() + " is not valid JSON: " + v.name + " is drawn without its barriers.");
+      }
+    }
     if (auto t = read_table(series_dir / "reference.csv")) v.sources.push_back({reference_label(v.reference), "", std::move(*t)});
     for (const json* run : v.runs) {
       const std::string engine = str(*run, "engine");
@@ -310,7 +328,7 @@ void write_report(const fs::path& dir, const Progress& progress) {
   std::ostringstream page;
   page << "<!doctype html>\n<html lang=en><head><meta charset=utf-8><title>physval report</title>"
        << "<meta name=viewport content=\"width=device-width, initial-scale=1\"><style>" << kStyle
-       << "</style></head><body>\n<h1>physval report</h1>\n<p class=ctx>";
+       << "</style>" << report_detail::player_head() << "</head><body>\n<h1>physval report</h1>\n<p class=ctx>";
   {
     std::vector<std::string> parts;
     const std::string version = str(context, "physval_version", str(results, "physval_version"));
@@ -384,6 +402,8 @@ void write_report(const fs::path& dir, const Progress& progress) {
                              "reference, per scenario. Log scale: one grid line is a factor of ten."));
   }
 
+  report_detail::PlayerSection player_totals;
+  std::size_t players = 0;
   std::size_t index = 0;
   for (const ScenarioView& v : views) {
     ++index;
@@ -414,6 +434,15 @@ void write_report(const fs::path& dir, const Progress& progress) {
       page << "<p class=note>No time series in series/" << html(base) << "/: nothing to plot.</p>\n";
       continue;
     }
+    {
+      const report_detail::PlayerSection player = report_detail::player_section(v, engines, base + "-player");
+      page << "<h3>Scene player</h3>\n" << player.html;
+      player_totals.raw_bytes += player.raw_bytes;
+      player_totals.coded_bytes += player.coded_bytes;
+      player_totals.packed_bytes += player.packed_bytes;
+      player_totals.embedded_bytes += player.embedded_bytes;
+      ++players;
+    }
     page << (draw(energy_figure(v, engines), base + "_energy", v.name + " energy over time",
                              "Top: total energy of each engine's run and of the reference. Bottom: how far each run's "
                              "energy has moved from its starting value, log scale (a straight rising line is a steady "
@@ -432,8 +461,16 @@ void write_report(const fs::path& dir, const Progress& progress) {
       page << "<p class=note>No contacts in this scenario (reference and engines).</p>\n";
     }
   }
+  if (players > 0) {
+    auto kb = [](std::size_t bytes) { return fmt(static_cast<double>(bytes) / 1024.0, "%.0f") + " KB"; };
+    page << "<p class=ctx>Scene players: " << players << ", their series resampled to at most "
+         << report_detail::kMaxFrames << " frames and embedded as " << kb(player_totals.embedded_bytes)
+         << " of text: " << kb(player_totals.raw_bytes) << " as float64, " << kb(player_totals.coded_bytes)
+         << " quantized to 1/" << fmt(report_detail::kQuantizationSteps, "%.0f") << " of each scene and delta coded, "
+         << kb(player_totals.packed_bytes) << " deflated, base64 in the page.</p>\n";
+  }
   page << "<p class=ctx>Written by physval report from " << html(results_file.filename().string())
-       << ". Plots drawn with gnuplot.</p>\n</body></html>\n";
+       << ". Plots drawn with gnuplot.</p>\n" << report_detail::player_script() << "</body></html>\n";
 
   say("report: drawing " + std::to_string(jobs.size()) + " plots with one gnuplot process");
   std::vector<std::string> errors;

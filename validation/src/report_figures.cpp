@@ -86,8 +86,6 @@ std::optional<Table> read_table(const fs::path& file) {
 
 namespace {
 
-constexpr const char* kReferenceColour = "#a8a8a8";
-
 // Colour and dash of an engine: by its place among all engines of the results, so an
 // engine looks the same in every plot of the report.
 struct Look {
@@ -125,7 +123,57 @@ plot::Series curve(const Source& s, const std::vector<std::string>& engines, con
   return c;
 }
 
+// Beyond this many samples a time series is drawn as its min/max envelope over
+// kEnvelopeBins bins: thousands of oscillations in 1000 pixels otherwise alias into a
+// solid fill (orbit_1000_periods' energy).
+constexpr std::size_t kEnvelopeBins = 250;
+constexpr std::size_t kEnvelopeAbove = 2 * kEnvelopeBins;
+
+// A time series as one curve, or as two (its upper and lower envelope, one legend
+// entry) when it is too long to draw point by point.
+std::vector<plot::Series> time_curves(const Source& s, const std::vector<std::string>& engines, const std::vector<double>& t,
+                                      const std::vector<double>& y) {
+  if (t.size() <= kEnvelopeAbove || t.size() != y.size()) return {curve(s, engines, t, y)};
+  const double t0 = t.front(), t1 = t.back();
+  if (!(t1 > t0)) return {curve(s, engines, t, y)};
+  std::vector<double> centre, lo, hi;
+  std::size_t k = 0;
+  for (std::size_t b = 0; b < kEnvelopeBins; ++b) {
+    const double end = t0 + (t1 - t0) * static_cast<double>(b + 1) / kEnvelopeBins;
+    double mn = INFINITY, mx = -INFINITY, sum_t = 0.0;
+    std::size_t n = 0;
+    for (; k < t.size() && (t[k] <= end || b + 1 == kEnvelopeBins); ++k) {
+      if (!std::isfinite(y[k])) continue;
+      mn = std::min(mn, y[k]);
+      mx = std::max(mx, y[k]);
+      sum_t += t[k];
+      ++n;
+    }
+    if (n == 0) continue;
+    centre.push_back(sum_t / static_cast<double>(n));
+    lo.push_back(mn);
+    hi.push_back(mx);
+  }
+  plot::Series upper = curve(s, engines, centre, hi);
+  plot::Series lower = curve(s, engines, centre, lo);
+  upper.title += " (min and max per " + fmt((t1 - t0) / kEnvelopeBins) + " s)";
+  lower.title.clear();
+  if (s.engine.empty()) {
+    upper.line_width = lower.line_width = 3.0;
+  } else {
+    lower.style = plot::Style::Lines;
+    upper.line_width = lower.line_width = 1.5;
+    upper.point_interval = std::max<int>(1, static_cast<int>(centre.size() / 10));
+  }
+  return {upper, lower};
+}
+
 }  // namespace
+
+std::string engine_colour(const std::vector<std::string>& engines, const std::string& engine) {
+  const Look l = look_of(engines, engine);
+  return plot::palette()[static_cast<std::size_t>(l.colour) % plot::palette().size()];
+}
 
 std::string reference_label(const json* ref) {
   std::string label = "reference";
@@ -158,10 +206,10 @@ plot::Figure energy_figure(const ScenarioView& v, const std::vector<std::string>
     const auto* t = s.table.column("t");
     const auto* e = s.table.column("energy");
     if (t == nullptr || e == nullptr || e->empty()) continue;
-    total.series.push_back(curve(s, engines, *t, *e));
+    for (plot::Series& c : time_curves(s, engines, *t, *e)) total.series.push_back(std::move(c));
     std::vector<double> d(e->size());
     for (std::size_t i = 0; i < e->size(); ++i) d[i] = std::abs((*e)[i] - e->front());
-    error.series.push_back(curve(s, engines, *t, d));
+    for (plot::Series& c : time_curves(s, engines, *t, d)) error.series.push_back(std::move(c));
   }
   // One legend, under the top panel, where every run has something to draw (the
   // reference's own energy error may be exactly zero: nothing on a log axis).
@@ -174,7 +222,7 @@ plot::Figure energy_figure(const ScenarioView& v, const std::vector<std::string>
 plot::Figure momentum_figure(const ScenarioView& v, const std::vector<std::string>& engines) {
   plot::Figure fig;
   fig.title = v.name + ": momentum over time";
-  fig.height = 950;
+  fig.height = 1050;   // the legend under the last panel takes from its height
   struct Part {
     const char* column;
     const char* title;
@@ -189,10 +237,15 @@ plot::Figure momentum_figure(const ScenarioView& v, const std::vector<std::strin
     p.x.label = "time (s)";
     p.y.label = part.unit;
     p.key = "outside right top";
+    if (v.duration > 0.0) {   // every panel over the whole run, so their time axes line up
+      p.x.min = 0.0;
+      p.x.max = v.duration;
+    }
     for (const Source& s : v.sources) {
       const auto* t = s.table.column("t");
       const auto* y = s.table.column(part.column);
-      if (t != nullptr && y != nullptr) p.series.push_back(curve(s, engines, *t, *y));
+      if (t == nullptr || y == nullptr) continue;
+      for (plot::Series& c : time_curves(s, engines, *t, *y)) p.series.push_back(std::move(c));
     }
     fig.panels.push_back(std::move(p));
   }
@@ -217,6 +270,80 @@ struct Extent {
   bool empty() const { return !(lo <= hi); }
 };
 
+// Whether a path turns so sharply from sample to sample (over 90 degrees on average)
+// that joining its samples would draw chords, not the path: an orbit sampled twice a
+// period.
+bool sampled_too_coarsely(const std::vector<double>& x, const std::vector<double>& y) {
+  double turning = 0.0;
+  std::size_t turns = 0;
+  double px = NAN, py = NAN;   // the previous step
+  for (std::size_t k = 1; k < x.size() && k < y.size(); ++k) {
+    const double dx = x[k] - x[k - 1], dy = y[k] - y[k - 1];
+    if (!std::isfinite(dx) || !std::isfinite(dy) || (dx == 0.0 && dy == 0.0)) continue;
+    if (std::isfinite(px)) {
+      turning += std::abs(std::atan2(px * dy - py * dx, px * dx + py * dy));
+      ++turns;
+    }
+    px = dx;
+    py = dy;
+  }
+  return turns >= 50 && turning / static_cast<double>(turns) > 0.5 * M_PI;
+}
+
+struct Rect {
+  double x0, y0, x1, y1;
+};
+using Point = std::pair<double, double>;
+
+// The scene's barriers as segments: walls, each surface's polyline, each box's sides.
+std::vector<std::pair<Point, Point>> barrier_segments(const json& geometry) {
+  std::vector<std::pair<Point, Point>> out;
+  auto point = [](const json& p) -> std::optional<Point> {
+    if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number()) return std::nullopt;
+    return Point{p[0].get<double>(), p[1].get<double>()};
+  };
+  for (const json& w : member(geometry, "walls").is_array() ? geometry["walls"] : json::array()) {
+    auto a = point(member(w, "from")), b = point(member(w, "to"));
+    if (a && b) out.emplace_back(*a, *b);
+  }
+  for (const json& s : member(geometry, "surfaces").is_array() ? geometry["surfaces"] : json::array()) {
+    const json& pts = member(s, "points");
+    for (std::size_t i = 1; pts.is_array() && i < pts.size(); ++i) {
+      auto a = point(pts[i - 1]), b = point(pts[i]);
+      if (a && b) out.emplace_back(*a, *b);
+    }
+  }
+  for (const json& b : member(geometry, "boxes").is_array() ? geometry["boxes"] : json::array()) {
+    auto lo = point(member(b, "min")), hi = point(member(b, "max"));
+    if (!lo || !hi) continue;
+    const Point c[4] = {*lo, {hi->first, lo->second}, *hi, {lo->first, hi->second}};
+    for (int i = 0; i < 4; ++i) out.emplace_back(c[i], c[(i + 1) % 4]);
+  }
+  return out;
+}
+
+// Liang-Barsky: the part of segment a-b inside the rectangle, if any.
+std::optional<std::pair<Point, Point>> clip_segment(Point a, Point b, const Rect& r) {
+  const double dx = b.first - a.first, dy = b.second - a.second;
+  double t0 = 0.0, t1 = 1.0;
+  const double p[4] = {-dx, dx, -dy, dy};
+  const double q[4] = {a.first - r.x0, r.x1 - a.first, a.second - r.y0, r.y1 - a.second};
+  for (int i = 0; i < 4; ++i) {
+    if (p[i] == 0.0) {
+      if (q[i] < 0.0) return std::nullopt;
+      continue;
+    }
+    const double t = q[i] / p[i];
+    if (p[i] < 0.0) {
+      t0 = std::max(t0, t);
+    } else {
+      t1 = std::min(t1, t);
+    }
+  }
+  if (t0 > t1) return std::nullopt;
+  return std::pair<Point, Point>{{a.first + t0 * dx, a.second + t0 * dy}, {a.first + t1 * dx, a.second + t1 * dy}};
+}
+
 }  // namespace
 
 plot::Figure trajectory_figure(const ScenarioView& v, const std::vector<std::string>& engines) {
@@ -225,10 +352,11 @@ plot::Figure trajectory_figure(const ScenarioView& v, const std::vector<std::str
   plot::Panel p;
   p.x.label = "x (m)";
   p.y.label = "y (m)";
-  p.key = "below center horizontal Left reverse";
+  p.key = "below center horizontal Left reverse maxcols 3";
   p.equal_aspect = true;
   std::set<std::string> labelled;
   std::size_t body_total = 0;
+  bool dotted = false;
   for (const Source& s : v.sources) {
     const std::vector<std::string> bodies = s.table.bodies();
     body_total = std::max(body_total, bodies.size());
@@ -238,6 +366,13 @@ plot::Figure trajectory_figure(const ScenarioView& v, const std::vector<std::str
       plot::Series c = curve(s, engines, x, y);
       if (b > 0) c.title.clear();   // one legend entry per engine
       if (!s.engine.empty()) c.style = plot::Style::Lines;
+      if (sampled_too_coarsely(x, y)) {   // chords across an orbit, not a path: dots
+        c.style = plot::Style::Points;
+        c.point_type = 7;
+        c.point_size = s.engine.empty() ? 0.9 : 0.45;
+        c.point_interval = 1;
+        dotted = true;
+      }
       p.series.push_back(c);
       // Where the body ends, as a marker: divergence shows as markers apart.
       for (std::size_t k = x.size(); k-- > 0;) {
@@ -273,6 +408,24 @@ plot::Figure trajectory_figure(const ScenarioView& v, const std::vector<std::str
       ey.add(c.y[k]);
     }
   }
+  // Barriers near the paths (within a quarter of their span and a body's radius) are
+  // part of the picture: a wall the ball bounces off, a box it stops short of.
+  if (!ex.empty()) {
+    double radius = 0.0;
+    for (const json& b : member(v.geometry, "bodies").is_array() ? v.geometry["bodies"] : json::array()) {
+      radius = std::max(radius, num(b, "radius").value_or(0.0));
+    }
+    const double grow = 0.25 * std::max(ex.hi - ex.lo, ey.hi - ey.lo) + 1.5 * radius;
+    const Rect near{ex.lo - grow, ey.lo - grow, ex.hi + grow, ey.hi + grow};
+    for (const auto& [a, b] : barrier_segments(v.geometry)) {
+      if (auto c = clip_segment(a, b, near)) {
+        ex.add(c->first.first);
+        ex.add(c->second.first);
+        ey.add(c->first.second);
+        ey.add(c->second.second);
+      }
+    }
+  }
   if (!ex.empty()) {
     constexpr double kPlotAspect = 1.5;   // width / height of the plot area, m per m
     double xs = ex.hi - ex.lo, ys = ey.hi - ey.lo;
@@ -289,6 +442,27 @@ plot::Figure trajectory_figure(const ScenarioView& v, const std::vector<std::str
     p.x.max = cx + 0.55 * xs;
     p.y.min = cy - 0.55 * ys;
     p.y.max = cy + 0.55 * ys;
+  }
+  // The barriers, over the paths, cut to the plotted area (a long floor under a short
+  // fall crosses it; both its ends may lie outside).
+  if (p.x.min && p.x.max && p.y.min && p.y.max) {
+    plot::Series barriers;
+    barriers.title = "walls, surfaces, boxes";
+    barriers.rgb = "#333333";
+    barriers.style = plot::Style::Lines;
+    barriers.line_width = 3.0;
+    const Rect view{*p.x.min, *p.y.min, *p.x.max, *p.y.max};
+    for (const auto& [a, b] : barrier_segments(v.geometry)) {
+      if (auto clipped = clip_segment(a, b, view)) {
+        barriers.x.insert(barriers.x.end(), {clipped->first.first, clipped->second.first, NAN});
+        barriers.y.insert(barriers.y.end(), {clipped->first.second, clipped->second.second, NAN});
+      }
+    }
+    if (!barriers.x.empty()) {
+      barriers.x.pop_back();
+      barriers.y.pop_back();
+      p.series.insert(p.series.begin(), std::move(barriers));   // first: the legend reads barriers, then engines
+    }
   }
   // Names that would print over one another (a gas, a stack): only the first of any
   // that start within a label's size of each other keeps its name.
@@ -308,6 +482,10 @@ plot::Figure trajectory_figure(const ScenarioView& v, const std::vector<std::str
   }
   fig.title = v.name + ": trajectories, engines overlaid on the reference";
   p.title = "each body's path; its name marks the start, a marker the end";
+  if (dotted) {
+    p.note = (p.note.empty() ? "" : p.note + "; ") +
+             std::string("paths sampled too coarsely to join (turning over 90 degrees a sample) are drawn as dots");
+  }
   if (body_total > kMaxTrajectoryBodies) {
     p.title += " (first " + std::to_string(kMaxTrajectoryBodies) + " of " + std::to_string(body_total) + " bodies)";
   }

@@ -61,9 +61,14 @@ struct ScenarioView {
   const json* reference = nullptr;
   std::vector<Source> sources;   // the reference first (drawn underneath), then engines
   double duration = 0.0;
+  json geometry;                 // series/<scenario>/scene.json (null when absent): bodies, barriers
 };
 
 std::string reference_label(const json* ref);
+
+// An engine's colour in every plot and in the player: by its place among all engines.
+std::string engine_colour(const std::vector<std::string>& engines, const std::string& engine);
+constexpr const char* kReferenceColour = "#a8a8a8";
 
 plot::Figure energy_figure(const ScenarioView& v, const std::vector<std::string>& engines);
 plot::Figure momentum_figure(const ScenarioView& v, const std::vector<std::string>& engines);

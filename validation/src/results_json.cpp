@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -86,6 +87,7 @@ json run_to_json(const RunRecord& r) {
           {"status", run_status_name(r.status)},
           {"reason", r.reason},
           {"diverged_at", opt(r.diverged_at)},
+          {"known_divergence", r.known_divergence},
           {"wall_seconds", r.wall_seconds},
           {"load_seconds", r.load_seconds},
           {"settings", settings},
@@ -209,10 +211,44 @@ void StagedOutputFolder::commit() {
   if (had_old) fs::remove_all(old, ec);
 }
 
+json scene_geometry_json(const ScenarioResult& sr) {
+  // Every body any run had (particles appear in the runs only), in first-seen order.
+  json bodies = json::array();
+  std::vector<std::string> seen;
+  auto add_bodies = [&](const RunRecord& r) {
+    for (const BodyMeta& b : r.bodies) {
+      if (std::find(seen.begin(), seen.end(), b.name) != seen.end()) continue;
+      seen.push_back(b.name);
+      bodies.push_back({{"name", b.name}, {"radius", b.radius}, {"mass", b.mass}, {"static", b.is_static}});
+    }
+  };
+  if (sr.reference.run) add_bodies(*sr.reference.run);
+  for (const RunRecord& r : sr.runs) add_bodies(r);
+  for (const BodyDef& b : sr.scene.bodies) {   // a scene no engine ran
+    if (std::find(seen.begin(), seen.end(), b.name) != seen.end()) continue;
+    seen.push_back(b.name);
+    bodies.push_back({{"name", b.name}, {"radius", b.radius}, {"mass", b.mass}, {"static", b.is_static}});
+  }
+  json walls = json::array(), boxes = json::array(), surfaces = json::array();
+  for (const WallDef& w : sr.scene.walls) walls.push_back({{"name", w.name}, {"from", vec(w.from)}, {"to", vec(w.to)}});
+  for (const BoxDef& b : sr.scene.boxes) boxes.push_back({{"name", b.name}, {"min", vec(b.min)}, {"max", vec(b.max)}});
+  for (const SurfaceDef& s : sr.scene.surfaces) {
+    json points = json::array();
+    for (Vec2 p : s.points) points.push_back(vec(p));
+    surfaces.push_back({{"name", s.name}, {"points", points}});
+  }
+  return {{"scenario", sr.scene.name}, {"duration", sr.scene.duration}, {"dt", sr.scene.dt},
+          {"bodies", bodies},          {"walls", walls},                 {"boxes", boxes},
+          {"surfaces", surfaces}};
+}
+
 void write_results(const std::filesystem::path& dir, const SuiteResult& result) {
-  // Series first: results.json, written last, is what marks a complete output.
-  constexpr std::size_t kMaxBodiesInSeries = 32;
+  // Series first: results.json, written last, is what marks a complete output. The
+  // report's scene player draws every body, so the series hold up to this many.
+  constexpr std::size_t kMaxBodiesInSeries = 400;
   for (const ScenarioResult& sr : result.scenarios) {
+    write_file_atomically(dir / "series" / safe_file_name(sr.scene.name) / "scene.json",
+                          scene_geometry_json(sr).dump(1) + "\n");
     auto write_series = [&](const RunRecord& r, const std::string& label) {
       if (r.series.time.empty()) return;
       std::ostringstream os;

@@ -74,6 +74,10 @@ std::vector<std::uint8_t> encode_run_record(const RunRecord& r) {
   for (const auto& s : r.series.states) states.push_back(states_to(s));
   j["series"] = {{"time", time}, {"totals", totals}, {"states", states}};
   j["final_states"] = states_to(r.final_states);
+  const ContainmentRecord& c = r.containment;
+  j["containment"] = json::array({c.measured, c.max_penetration, opt(c.max_penetration_time), c.max_penetration_what,
+                                  c.escaped_bodies ? json(*c.escaped_bodies) : json(nullptr), opt(c.first_escape_time),
+                                  c.first_escape});
   return json::to_cbor(j);
 }
 
@@ -122,6 +126,14 @@ RunRecord decode_run_record(const std::vector<std::uint8_t>& bytes) {
   }
   for (const json& st : s.at("states")) r.series.states.push_back(states_from(st));
   r.final_states = states_from(j.at("final_states"));
+  const json& c = j.at("containment");
+  r.containment.measured = c.at(0).get<bool>();
+  r.containment.max_penetration = c.at(1).get<double>();
+  r.containment.max_penetration_time = opt(c.at(2));
+  r.containment.max_penetration_what = c.at(3).get<std::string>();
+  if (!c.at(4).is_null()) r.containment.escaped_bodies = c.at(4).get<int>();
+  r.containment.first_escape_time = opt(c.at(5));
+  r.containment.first_escape = c.at(6).get<std::string>();
   return r;
 }
 

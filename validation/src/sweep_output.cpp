@@ -106,15 +106,26 @@ std::vector<std::pair<std::string, std::vector<std::size_t>>> groups_of(const Sw
   return groups;
 }
 
-// The dash type of an engine's lines: one per engine in order of appearance.
-int engine_dash(const SweepResult& r, const std::string& engine) {
-  std::vector<std::string> seen;
+// How a line looks: its colour says the engine (in order of appearance, as in the
+// report), its dash and marker the engine's setting (in order of appearance), so four
+// Box2D and four Bullet settings are eight lines told apart at a glance.
+void style_line(const SweepResult& r, const std::string& engine, const std::string& setting, plot::Series& s) {
+  std::vector<std::string> engines;
+  std::vector<std::string> settings;   // this engine's
   for (const SweepPoint& p : r.points) {
-    if (std::find(seen.begin(), seen.end(), p.engine) == seen.end()) seen.push_back(p.engine);
+    if (std::find(engines.begin(), engines.end(), p.engine) == engines.end()) engines.push_back(p.engine);
+    if (p.engine == engine && std::find(settings.begin(), settings.end(), p.setting) == settings.end()) {
+      settings.push_back(p.setting);
+    }
   }
-  const auto it = std::find(seen.begin(), seen.end(), engine);
-  static constexpr int kDashes[] = {1, 2, 4, 5};
-  return kDashes[static_cast<std::size_t>(it - seen.begin()) % 4];
+  const auto e = static_cast<std::size_t>(std::find(engines.begin(), engines.end(), engine) - engines.begin());
+  const auto k = static_cast<std::size_t>(std::find(settings.begin(), settings.end(), setting) - settings.begin());
+  static constexpr int kDashes[] = {1, 2, 4, 5, 3};
+  static constexpr int kPoints[] = {7, 5, 9, 13, 11, 3};
+  s.color = static_cast<int>(e);
+  s.dash = kDashes[k % 5];
+  s.point_type = kPoints[k % 6];
+  s.point_size = 1.3;
 }
 
 std::string order_text(const LogLogFit& f) {
@@ -168,8 +179,7 @@ plot::Figure speed_vs_error_figure(const SweepResult& r) {
     plot::Series s;
     const SweepPoint& first = r.points[groups[g].second.front()];
     s.title = legend_name(first.engine, first.setting);
-    s.color = static_cast<int>(g);
-    s.dash = engine_dash(r, r.points[groups[g].second.front()].engine);
+    style_line(r, first.engine, first.setting, s);
     for (std::size_t i : groups[g].second) {
       const SweepPoint& p = r.points[i];
       if (!usable(p) || !p.position_error) continue;
@@ -235,8 +245,7 @@ plot::Figure error_vs_dt_figure(const SweepResult& r) {
       order_note = fit;
     }
     s.title = legend_name(first.engine, first.setting) + ": " + order_note;
-    s.color = static_cast<int>(g);
-    s.dash = engine_dash(r, first.engine);
+    style_line(r, first.engine, first.setting, s);
     for (std::size_t i : groups[g].second) {
       const SweepPoint& p = r.points[i];
       if (p.status != RunStatus::Ok || !p.position_error) continue;

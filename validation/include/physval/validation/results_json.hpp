@@ -14,6 +14,10 @@ namespace physval {
 nlohmann::json context_json();
 nlohmann::json run_to_json(const RunRecord& run);
 nlohmann::json suite_to_json(const SuiteResult& result);
+// series/<scenario>/scene.json: what the report's player draws besides the series:
+// every body's name, radius, mass and whether it is static, and the barriers (walls
+// from/to, boxes min/max, surfaces' points), in scene coordinates (m).
+nlohmann::json scene_geometry_json(const ScenarioResult& result);
 
 // Writes text to path whole or not at all (temporary file in the same folder, then
 // rename). Creates the folder. Throws std::runtime_error on failure.
