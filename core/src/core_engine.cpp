@@ -185,6 +185,23 @@ double CoreEngine::particle_intensity(std::size_t i) const {
 
 const CoreStepStats& CoreEngine::last_step_stats() const { return world_->stats; }
 
+std::vector<CoreEngine::RestingForce> CoreEngine::resting_forces() const {
+  std::vector<RestingForce> out;
+  for (const core_detail::RestingContact& c : core_detail::resting_contacts(*world_)) {
+    RestingForce f;
+    f.body = c.body;
+    f.normal = c.n;
+    f.force = c.force;
+    if (c.other & core_detail::kBodySupport) {
+      f.wall = world_->statics.segments[c.other & ~core_detail::kBodySupport].owner;
+    } else {
+      f.other = static_cast<std::int64_t>(c.other);
+    }
+    out.push_back(std::move(f));
+  }
+  return out;
+}
+
 std::size_t CoreEngine::memory_bytes() const { return world_->memory_bytes(); }
 
 }  // namespace physval

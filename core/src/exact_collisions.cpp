@@ -165,7 +165,10 @@ class EventLoop {
     const Vec2 da = w_.path_acc(j) - w_.path_acc(i);
     const double R = w_.radius[i] + w_.radius[j];
     const double scale = inf_norm(pi) + inf_norm(pj) + R;
-    const double speed = length(dv) + length(da) * (T_ - t);
+    // Round-off in dv is that of the bodies' own velocities, not of their difference: two
+    // touching bodies moving together (an inelastic pair) approach at ~1e-17 m/s, an
+    // impulse that small changes no velocity, and the same impact would fire forever.
+    const double speed = length(vi) + length(vj) + (length(w_.path_acc(i)) + length(w_.path_acc(j))) * (T_ - t);
     const double s = toi::circle_circle(pj - pi, dv, da, R, T_ - t, toi::squared_tolerance(scale, speed, R));
     if (s == toi::kNever) return;
     push(Event::make(t + s, i, j, w_.version[i], w_.version[j], EventKind::Pair));
@@ -271,16 +274,78 @@ class EventLoop {
   }
 
   // Body x's path changed at time t: whatever rested on it (and on those) is free.
+  // A body held on x is judged again without it: still held by its other contacts,
+  // or free (and then whatever rested on it in turn).
   void free_dependents(std::uint32_t x, double t) {
-    if (w_.dep_head.empty() || w_.dep_head[x] == kNone) return;
-    w_.released.clear();
-    collect_dependents(w_, x);
-    for (std::uint32_t d : w_.released) {
-      w_.advance(d, t);
-      release_support(w_, d);
-      ++w_.version[d];
+    if (w_.dep_head.empty() || (w_.alive(x) && w_.stationary(x))) return;   // x did not move
+    if (w_.dep_head[x] != kNone) {
+      w_.released.clear();
+      collect_dependents(w_, x);
+      for (std::uint32_t d : w_.released) {
+        w_.advance(d, t);
+        release_support(w_, d);
+        ++w_.version[d];
+      }
+      // (copied: reschedule may free more bodies, reusing w_.released)
+      std::vector<std::uint32_t> freed(w_.released);
+      for (std::uint32_t d : freed) reschedule(d, t);
+      for (std::uint32_t d : freed) free_held_on(d, t);
     }
-    for (std::uint32_t d : w_.released) reschedule(d, t);
+    free_held_on(x, t);
+  }
+
+  void free_held_on(std::uint32_t x, double t) {
+    if (w_.held.empty() || (w_.alive(x) && w_.stationary(x))) return;
+    std::vector<std::uint32_t> on;
+    held_on(w_, x, on);
+    for (std::uint32_t k : on) {
+      if (!w_.is_held(k)) continue;
+      w_.advance(k, t);
+      unhold(w_, k);
+      w_.apath[k] = {};
+      if (hold(k)) continue;   // its other contacts hold it
+      w_.apath[k] = w_.acc[k];
+      ++w_.version[k];
+      reschedule(k, t);
+      free_dependents(k, t);
+    }
+  }
+
+  // Body i (advanced to now) held at rest by the stationary bodies and faces it touches.
+  bool hold(std::uint32_t i) {
+    const double r = w_.radius[i];
+    const double pad = r + w_.rest_speed(length(w_.acc[i]), ctx_.dt) * ctx_.dt + 1e-9 * (r + w_.length_scale);
+    const Vec2 p = w_.pos[i];
+    near_.clear();
+    w_.bp->query_box(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), i, near_);
+    if (try_hold(w_, i, ctx_.dt, near_, true)) return true;
+    const double t = w_.tloc[i];
+    if (!try_hold_group(w_, i, t, ctx_.dt, [this](Vec2 q, double h, std::vector<std::uint32_t>& out) {
+          out.clear();
+          w_.bp->query_box(make_aabb(q.x - h, q.y - h, q.x + h, q.y + h), kNone, out);
+        }, group_)) {
+      return false;
+    }
+    // The other members' paths changed too (now at rest): new versions, no events.
+    for (std::uint32_t m : group_) {
+      if (m == i) continue;
+      ++w_.version[m];
+      reschedule(m, t);
+    }
+    return true;
+  }
+  bool force_hold(std::uint32_t i) {
+    const double r = w_.radius[i];
+    const double pad = r + 1e-9 * (r + w_.length_scale);
+    const Vec2 p = w_.pos[i];
+    near_.clear();
+    w_.bp->query_box(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), i, near_);
+    return hold_wedged(w_, i, ctx_.dt, near_);
+  }
+  // i, pressed slowly onto the stationary j, held at rest by j and its other contacts.
+  bool hold_against(std::uint32_t i, std::uint32_t j) {
+    if (w_.stationary(i) || !w_.stationary(j)) return false;
+    return hold(i);
   }
 
   void destroy_after(std::uint32_t i, bool by_rule) {
@@ -347,7 +412,9 @@ class EventLoop {
     const Vec2 d = w_.pos[j] - w_.pos[i];
     const double dl = length(d);
     const Vec2 n = dl > 0.0 ? d / dl : Vec2{1.0, 0.0};
-    const PairMaterial m = w_.pair_material(w_.material[i], w_.material[j]);
+    PairMaterial m = w_.pair_material(w_.material[i], w_.material[j]);
+    // Inelastic collapse: below the collapse speed an impact is perfectly inelastic.
+    if (-dot(w_.vel[j] - w_.vel[i], n) < w_.collapse_speed(i, j)) m.restitution = 0.0;
     double min_sep = 0.0;
     bool settled = false;
     if (w_.any_forces) {
@@ -365,20 +432,57 @@ class EventLoop {
           } else if (can_rest_on(w_, j, i, n, vr)) {
             rest_on_body(w_, j, i, n);
             settled = true;
+          } else if (hold_against(i, j) || hold_against(j, i)) {
+            settled = true;   // at rest on several supports
           } else {
             min_sep = 0.5 * vr;
           }
         }
       }
     }
-    if (!settled && min_sep == 0.0 && resolve_simultaneous(w_, i, j, t, set_, impacted_)) {
+    const Vec2 vi_before = w_.vel[i], vj_before = w_.vel[j];
+    // Impacts of each body at this very instant: a slow body met again and again at one
+    // instant (a cycle of impacts among wedged bodies) is wedged too.
+    if (t != instant_) {
+      for (std::uint32_t x : counted_) same_instant_[x] = 0;
+      counted_.clear();
+      instant_ = t;
+    }
+    if (same_instant_.size() < w_.size()) same_instant_.resize(w_.size(), 0);
+    for (std::uint32_t x : {i, j}) {
+      if (same_instant_[x]++ == 0) counted_.push_back(x);
+    }
+    const bool cycling = same_instant_[i] > kCycle || same_instant_[j] > kCycle;
+    // A pressed, slow body that the impulses leave exactly as it was would meet the same
+    // impact at the same instant for ever: wedged, it is held where it is.
+    const auto wedged = [&]() {
+      const bool unchanged = w_.vel[i] == vi_before && w_.vel[j] == vj_before;
+      if (!(min_sep > 0.0 && unchanged) && !cycling) return false;
+      for (std::uint32_t x : {i, j}) {
+        if (!w_.stationary(x) && force_hold(x)) return true;
+      }
+      return false;
+    };
+    if (!settled && resolve_simultaneous(w_, i, j, t, set_, impacted_, min_sep)) {
+      if (wedged()) ++w_.stats.wedged;
       finish_simultaneous(t, t_abs);
       return;
     }
     if (!settled) {
-      resolve_pair(w_, i, j, n, m, min_sep);
-      after_velocity_change(i);
-      after_velocity_change(j);
+      const bool slow = -dot(w_.vel[j] - w_.vel[i], n) < w_.collapse_speed(i, j);
+      if (slow && w_.stationary(j) && !w_.stationary(i)) {
+        resolve_static(w_, i, -n, m, min_sep);   // its supports absorb a slow impact
+      } else if (slow && w_.stationary(i) && !w_.stationary(j)) {
+        resolve_static(w_, j, n, m, min_sep);
+      } else {
+        resolve_pair(w_, i, j, n, m, min_sep);
+      }
+      if (wedged()) {
+        ++w_.stats.wedged;
+      } else {
+        after_velocity_change(i);
+        after_velocity_change(j);
+      }
     }
     if (r.event) record_contact(w_, i, j, nullptr, t_abs, ctx_.dt);
     ++w_.version[i];
@@ -400,7 +504,13 @@ class EventLoop {
       after_velocity_change(b);
       ++w_.version[b];
     }
-    for (const BodyPair& p : impacted_) record_contact(w_, p.a, p.b, nullptr, t_abs, ctx_.dt);
+    for (const BodyPair& p : impacted_) {
+      if (p.a & kSimultaneousFace) {
+        record_contact(w_, p.b, kNone, &w_.statics.segments[p.a & ~kSimultaneousFace], t_abs, ctx_.dt);
+      } else {
+        record_contact(w_, p.a, p.b, nullptr, t_abs, ctx_.dt);
+      }
+    }
     for (std::uint32_t b : set_) {
       if (!w_.is_static(b)) reschedule(b, t);
     }
@@ -457,7 +567,10 @@ class EventLoop {
     const double vr = pressed ? w_.rest_speed(an, ctx_.dt) : 0.0;
     const bool slow = pressed && m.restitution * std::max(0.0, -vn) < vr;
     const bool own_support = w_.supported(i) && w_.support[i] == k;
-    if (slow && face && (!w_.supported(i) || own_support)) {
+    if (slow && face && !own_support && !w_.stationary(i) && hold(i)) {
+      // Pressed into a second face (a corner, a V) or a face beside bodies at rest:
+      // held at rest there if its contacts together can hold it.
+    } else if (slow && face && (!w_.supported(i) || own_support)) {
       // Settle: the normal velocity goes (friction impulse included), and the body
       // rests on this face until it is lifted, pulled away or slides off its end.
       PairMaterial inelastic = m;
@@ -466,6 +579,12 @@ class EventLoop {
       w_.support[i] = k;
       w_.support_n[i] = n;
       support_path(w_, i);
+    } else if (!slow && face && !own_support && !w_.any_rules &&
+               resolve_simultaneous(w_, i, kSimultaneousFace | k, t, set_, impacted_)) {
+      // Body i touches other bodies or faces at this instant: Newton's law at all of
+      // its contacts at once (a ball wedged between a wall and another ball).
+      finish_simultaneous(t, t_abs);
+      return;
     } else {
       resolve_static(w_, i, n_resp, m, slow ? 0.5 * vr : 0.0);
       // An interpolated normal must still send the body away from the segment.
@@ -503,6 +622,12 @@ class EventLoop {
   const double T_;
   std::vector<std::uint32_t> set_;      // the touching set of a simultaneous impact
   std::vector<BodyPair> impacted_;      // its pairs that took an impulse
+  std::vector<std::uint32_t> near_;     // bodies near one being held
+  std::vector<std::uint32_t> group_;    // a group held at once
+  static constexpr std::uint32_t kCycle = 64;
+  double instant_ = -1.0;                      // the time of the last pair impact
+  std::vector<std::uint32_t> same_instant_;    // per body: its impacts at that time
+  std::vector<std::uint32_t> counted_;         // bodies with a count to reset
 };
 
 }  // namespace

@@ -21,6 +21,8 @@
 // body does not rest on it: it micro-bounces (exact_collisions.cpp).
 #include <algorithm>
 #include <cmath>
+#include <numbers>
+#include <span>
 
 #include "physval/core/time_of_impact.hpp"
 #include "world.hpp"
@@ -72,7 +74,9 @@ Vec2 support_acceleration(const World& w, std::uint32_t i, Vec2 a, double vt) {
 }
 
 void release_support(World& w, std::uint32_t i) {
-  if (w.on_body(i)) {   // unlink from the supporter's list of dependents
+  if (w.is_held(i)) {   // forget its contacts
+    std::erase_if(w.held, [i](const HeldContact& c) { return c.body == i; });
+  } else if (w.on_body(i)) {   // unlink from the supporter's list of dependents
     const std::uint32_t j = w.support[i] & ~kBodySupport;
     std::uint32_t* link = &w.dep_head[j];
     while (*link != kNone && *link != i) link = &w.dep_next[*link];
@@ -114,6 +118,486 @@ void collect_dependents(World& w, std::uint32_t j) {
 
 namespace {
 
+// Whether the unit direction d lies in the convex cone spanned by the unit vectors g
+// (within `tol` radians of it): some generator along d, or two generators on either side
+// of d less than pi apart.
+bool in_cone(Vec2 d, std::span<const Vec2> g, double tol) {
+  double ccw = INFINITY, cw = -INFINITY;   // nearest generator angle on each side of d
+  for (const Vec2& x : g) {
+    const double phi = std::atan2(cross(d, x), dot(d, x));
+    if (std::fabs(phi) <= tol) return true;
+    if (phi > 0.0) {
+      ccw = std::min(ccw, phi);
+    } else {
+      cw = std::max(cw, phi);
+    }
+  }
+  return std::isfinite(ccw) && std::isfinite(cw) && ccw - cw < std::numbers::pi - tol;
+}
+
+bool related_bodies(const World& w, std::uint32_t i, std::uint32_t j) {
+  const std::size_t s = w.scene_bodies;
+  if ((w.flags[i] & kParticle) && w.parent[i - s] == j) return true;
+  if ((w.flags[j] & kParticle) && w.parent[j - s] == i) return true;
+  return false;
+}
+
+double holding_coefficient(const PairMaterial& m) {
+  return m.rolling_friction > 0.0 ? m.rolling_friction : std::max(m.static_friction, m.friction);
+}
+
+}  // namespace
+
+// The contacts that could hold body i now: faces it touches (within 1e-9 of its size
+// and the scene's), and stationary bodies in `near` it touches.
+static void touching_supports(World& w, std::uint32_t i, std::span<const std::uint32_t> near,
+                              std::vector<HeldContact>& out, std::vector<double>& mu) {
+  const double r = w.radius[i];
+  const Vec2 p = w.pos[i];
+  if (!w.statics.segments.empty()) {
+    const double tol = 1e-9 * (r + w.length_scale);
+    w.found_static.clear();
+    w.statics.query(make_aabb(p.x - r - tol, p.y - r - tol, p.x + r + tol, p.y + r + tol), w.found_static);
+    for (std::uint32_t k : w.found_static) {
+      const Segment& s = w.statics.segments[k];
+      if (w.any_rules && !w.response(w.group[i], s.group).collide) continue;
+      const double u = dot(p - s.from, s.dir);
+      if (u < 0.0 || u > s.length) continue;
+      const double D = dot(p - s.from, s.normal);
+      if (std::fabs(std::fabs(D) - r) > tol) continue;
+      out.push_back({i, kBodySupport | k, D >= 0.0 ? s.normal : -s.normal});
+      mu.push_back(holding_coefficient(w.pair_material(w.material[i], s.material)));
+    }
+  }
+  for (std::uint32_t j : near) {
+    if (j == i || !w.alive(j) || !w.stationary(j)) continue;
+    if ((w.flags[i] & kPoint) && (w.flags[j] & kPoint)) continue;
+    if (((w.flags[i] | w.flags[j]) & kParticle) && related_bodies(w, i, j)) continue;
+    if (w.any_rules && !w.response(w.group[i], w.group[j]).collide) continue;
+    const Vec2 d = p - w.pos[j];
+    const double dist = length(d);
+    const double R = r + w.radius[j];
+    if (!(dist > 0.0) || std::fabs(dist - R) > 1e-9 * (R + w.length_scale)) continue;
+    out.push_back({i, j, d / dist});
+    mu.push_back(holding_coefficient(w.pair_material(w.material[i], w.material[j])));
+  }
+}
+
+namespace {
+
+// A constraint "body i's centre lies on": a circle (around a body it touches) or a line
+// (a face moved out by i's radius).
+struct Locus {
+  bool line = false;
+  Vec2 c;        // circle centre, or a point of the line
+  double R = 0;  // circle radius
+  Vec2 n;        // line normal
+};
+
+// The intersections of two loci (at most two), appended to out.
+void intersect(const Locus& a, const Locus& b, std::vector<Vec2>& out) {
+  if (a.line && b.line) {
+    const double det = cross(a.n, b.n);
+    if (det == 0.0) return;
+    // n_a.x = n_a.c_a, n_b.x = n_b.c_b
+    const double ra = dot(a.n, a.c), rb = dot(b.n, b.c);
+    out.push_back({(ra * b.n.y - rb * a.n.y) / det, (a.n.x * rb - b.n.x * ra) / det});
+    return;
+  }
+  if (a.line != b.line) {
+    const Locus& l = a.line ? a : b;
+    const Locus& c = a.line ? b : a;
+    const double h = dot(l.n, c.c - l.c);
+    if (std::fabs(h) > c.R) return;
+    const Vec2 f = c.c - h * l.n;
+    const double half = std::sqrt(c.R * c.R - h * h);
+    out.push_back(f + half * perp(l.n));
+    out.push_back(f - half * perp(l.n));
+    return;
+  }
+  const Vec2 d = b.c - a.c;
+  const double dl = length(d);
+  if (!(dl > 0.0)) return;
+  const double x = (a.R * a.R - b.R * b.R + dl * dl) / (2.0 * dl);
+  const double h2 = a.R * a.R - x * x;
+  if (h2 < 0.0) return;
+  const Vec2 u = d / dl;
+  const Vec2 f = a.c + x * u;
+  const double h = std::sqrt(h2);
+  out.push_back(f + h * perp(u));
+  out.push_back(f - h * perp(u));
+}
+
+// The loci of body i's supports near p: faces and stationary bodies within `reach` of
+// touching, with their gap.
+struct NearSupport {
+  Locus locus;
+  double gap;
+};
+
+void near_supports(World& w, std::uint32_t i, std::span<const std::uint32_t> near, double reach,
+                   std::vector<NearSupport>& out) {
+  const double r = w.radius[i];
+  const Vec2 p = w.pos[i];
+  if (!w.statics.segments.empty()) {
+    w.found_static.clear();
+    const double pad = r + reach;
+    w.statics.query(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), w.found_static);
+    for (std::uint32_t k : w.found_static) {
+      const Segment& s = w.statics.segments[k];
+      if (w.any_rules && !w.response(w.group[i], s.group).collide) continue;
+      const double D = dot(p - s.from, s.normal);
+      const Vec2 n = D >= 0.0 ? s.normal : -s.normal;
+      const double gap = std::fabs(D) - r;
+      if (gap > reach) continue;
+      Locus l;
+      l.line = true;
+      l.n = n;
+      l.c = s.from + r * n;
+      out.push_back({l, gap});
+    }
+  }
+  for (std::uint32_t j : near) {
+    if (j == i || !w.alive(j) || !w.stationary(j)) continue;
+    if ((w.flags[i] & kPoint) && (w.flags[j] & kPoint)) continue;
+    if (((w.flags[i] | w.flags[j]) & kParticle) && related_bodies(w, i, j)) continue;
+    if (w.any_rules && !w.response(w.group[i], w.group[j]).collide) continue;
+    const double R = r + w.radius[j];
+    const double gap = length(p - w.pos[j]) - R;
+    if (gap > reach) continue;
+    Locus l;
+    l.c = w.pos[j];
+    l.R = R;
+    out.push_back({l, gap});
+  }
+}
+
+// Whether body i at its position overlaps any face or stationary body by more than
+// round-off, or sits off the span of a face it touches.
+bool clear_of_everything(World& w, std::uint32_t i, std::span<const std::uint32_t> near) {
+  const double r = w.radius[i];
+  const Vec2 p = w.pos[i];
+  const double tol = 1e-12 * (r + w.length_scale);   // round-off only: it must not overlap
+  if (!w.statics.segments.empty()) {
+    w.found_static.clear();
+    w.statics.query(make_aabb(p.x - r - tol, p.y - r - tol, p.x + r + tol, p.y + r + tol), w.found_static);
+    for (std::uint32_t k : w.found_static) {
+      const Segment& s = w.statics.segments[k];
+      if (w.any_rules && !w.response(w.group[i], s.group).collide) continue;
+      const double u = dot(p - s.from, s.dir);
+      const double D = std::fabs(dot(p - s.from, s.normal));
+      if (u >= 0.0 && u <= s.length) {
+        if (D < r - tol) return false;
+      } else if (length(p - (u < 0.0 ? s.from : s.to)) < r - tol) {
+        return false;
+      }
+    }
+  }
+  for (std::uint32_t j : near) {
+    if (j == i || !w.alive(j)) continue;
+    if ((w.flags[i] & kPoint) && (w.flags[j] & kPoint)) continue;
+    const double R = r + w.radius[j];
+    if (length(p - w.pos_at(j, w.tloc[i])) < R - 1e-12 * (R + w.length_scale)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near, bool settle_into_pocket) {
+  if (!w.dynamic(i) || w.is_held(i) || w.acc.empty()) return false;
+  const Vec2 a = w.acc[i];
+  const double amag = length(a);
+  if (!(amag > 0.0)) return false;   // nothing to hold against
+  const double vr = w.rest_speed(amag, dt);
+  if (length(w.vel[i]) > vr) return false;
+  thread_local std::vector<HeldContact> contacts;
+  thread_local std::vector<double> mu;
+  thread_local std::vector<Vec2> gens;
+  thread_local std::vector<NearSupport> loci;
+  thread_local std::vector<Vec2> points;
+  const Vec2 d = (-1.0 / amag) * a;   // the direction the supports must push
+  const auto holds_here = [&]() {
+    contacts.clear();
+    mu.clear();
+    gens.clear();
+    touching_supports(w, i, near, contacts, mu);
+    if (contacts.empty()) return false;
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+      const Vec2 n = contacts[k].n;
+      gens.push_back(n);
+      if (mu[k] > 0.0) {   // the edges of the static friction cone
+        const double th = std::atan(mu[k]);
+        gens.push_back(std::cos(th) * n + std::sin(th) * perp(n));
+        gens.push_back(std::cos(th) * n - std::sin(th) * perp(n));
+      }
+    }
+    return in_cone(d, gens, 1e-12);
+  };
+  bool held = holds_here();
+  if (!held && settle_into_pocket) {
+    // Inelastic collapse into a pocket: a slow body on one support that cannot hold it
+    // slides and hops, ever shorter, into the pocket that a second support within
+    // rest_speed x dt forms with the first: infinitely many impacts in a finite time,
+    // whose limit is the pocket. Go to that limit if the two hold it there (moving
+    // along the force, so no energy is gained).
+    const double reach = vr * dt;
+    const double tol = 1e-9 * (w.radius[i] + w.length_scale);
+    loci.clear();
+    near_supports(w, i, near, reach, loci);
+    const Vec2 p0 = w.pos[i];
+    double best = INFINITY;
+    Vec2 best_p;
+    for (const NearSupport& s1 : loci) {
+      if (std::fabs(s1.gap) > tol) continue;   // the support it touches
+      for (const NearSupport& s2 : loci) {
+        if (&s1 == &s2 || std::fabs(s2.gap) <= tol) continue;
+        points.clear();
+        intersect(s1.locus, s2.locus, points);
+        for (const Vec2& q : points) {
+          const double dist = length(q - p0);
+          if (dist > reach || dist >= best || dot(q - p0, a) < 0.0) continue;
+          w.pos[i] = q;
+          if (clear_of_everything(w, i, near) && holds_here()) {
+            best = dist;
+            best_p = q;
+          }
+          w.pos[i] = p0;
+        }
+      }
+    }
+    if (best < INFINITY) {
+      w.pos[i] = best_p;
+      held = holds_here();
+      if (!held) w.pos[i] = p0;
+    }
+  }
+  if (!held) return false;
+  release_support(w, i);
+  w.vel[i] = {};
+  w.apath[i] = {};
+  w.support[i] = kHeld;
+  w.support_n[i] = d;
+  w.held.insert(w.held.end(), contacts.begin(), contacts.end());
+  return true;
+}
+
+bool try_hold_group(World& w, std::uint32_t seed, double t, double dt, const NearFn& near_fn,
+                    std::vector<std::uint32_t>& members) {
+  members.clear();
+  if (!w.dynamic(seed) || w.acc.empty() || w.stationary(seed)) return false;
+  constexpr std::size_t kMaxMembers = 64;
+  thread_local std::vector<std::uint32_t> buf;
+  thread_local std::vector<Vec2> pos;   // members' positions at t
+  const auto slow = [&](std::uint32_t j) {
+    const double a = length(w.acc[j]);
+    return a > 0.0 && length(w.vel_at(j, t)) <= w.rest_speed(a, dt);
+  };
+  if (!slow(seed)) return false;
+  members.assign(1, seed);
+  pos.assign(1, w.pos_at(seed, t));
+  // The slow free bodies touching the seed, and those touching them.
+  for (std::size_t q = 0; q < members.size(); ++q) {
+    const std::uint32_t m = members[q];
+    const double r = w.radius[m];
+    near_fn(pos[q], r + 1e-9 * (r + w.length_scale), buf);
+    for (std::uint32_t j : buf) {
+      if (j == m || !w.dynamic(j) || w.stationary(j)) continue;
+      if (w.supported(j) && !w.on_body(j)) continue;   // on a face: its own path
+      if ((w.flags[m] & kPoint) && (w.flags[j] & kPoint)) continue;
+      if (((w.flags[m] | w.flags[j]) & kParticle) && related_bodies(w, m, j)) continue;
+      if (w.any_rules && !w.response(w.group[m], w.group[j]).collide) continue;
+      if (std::find(members.begin(), members.end(), j) != members.end()) continue;
+      const Vec2 pj = w.pos_at(j, t);
+      const double R = r + w.radius[j];
+      if (std::fabs(length(pj - pos[q]) - R) > 1e-9 * (R + w.length_scale)) continue;
+      if (!slow(j)) return false;   // a moving body presses on the group
+      members.push_back(j);
+      pos.push_back(pj);
+      if (members.size() > kMaxMembers) return false;
+    }
+  }
+  if (members.size() < 2) return false;
+  // Contacts: each member's faces and stationary bodies, and member pairs.
+  struct GroupContact {
+    std::int32_t a;   // member index, or -1: fixed
+    std::int32_t b;
+    std::uint32_t other_a, other_b;   // for the record: body or kBodySupport | segment
+    Vec2 n;           // from a to b
+    double mu;
+  };
+  thread_local std::vector<GroupContact> gc;
+  thread_local std::vector<HeldContact> tmp;
+  thread_local std::vector<double> mus;
+  gc.clear();
+  for (std::size_t q = 0; q < members.size(); ++q) {
+    const std::uint32_t m = members[q];
+    const Vec2 saved = w.pos[m];
+    w.pos[m] = pos[q];
+    near_fn(pos[q], w.radius[m] + 1e-9 * (w.radius[m] + w.length_scale), buf);
+    tmp.clear();
+    mus.clear();
+    touching_supports(w, m, buf, tmp, mus);
+    w.pos[m] = saved;
+    for (std::size_t k = 0; k < tmp.size(); ++k) {
+      gc.push_back({-1, static_cast<std::int32_t>(q), tmp[k].other, m, tmp[k].n, mus[k]});
+    }
+    for (std::size_t l = q + 1; l < members.size(); ++l) {
+      const std::uint32_t j = members[l];
+      const Vec2 d = pos[l] - pos[q];
+      const double R = w.radius[m] + w.radius[j];
+      const double dl = length(d);
+      if (!(dl > 0.0) || std::fabs(dl - R) > 1e-9 * (R + w.length_scale)) continue;
+      gc.push_back({static_cast<std::int32_t>(q), static_cast<std::int32_t>(l), m, j, d / dl,
+                    holding_coefficient(w.pair_material(w.material[m], w.material[j]))});
+    }
+  }
+  // Forces that hold every member still: rows of normal and (with friction) tangential
+  // force, an acceleration-level contact problem solved by projected Gauss-Seidel.
+  struct Row {
+    std::int32_t a, b;
+    Vec2 d;
+    std::size_t c;
+    bool tangent;
+  };
+  thread_local std::vector<Row> rows;
+  thread_local std::vector<double> lam, Akk;
+  thread_local std::vector<Vec2> acc;   // members' accelerations under the current forces
+  rows.clear();
+  for (std::size_t k = 0; k < gc.size(); ++k) {
+    rows.push_back({gc[k].a, gc[k].b, gc[k].n, k, false});
+    if (gc[k].mu > 0.0) rows.push_back({gc[k].a, gc[k].b, perp(gc[k].n), k, true});
+  }
+  const auto inv = [&](std::int32_t x) { return x < 0 ? 0.0 : w.inv_mass[members[static_cast<std::size_t>(x)]]; };
+  acc.resize(members.size());
+  for (std::size_t q = 0; q < members.size(); ++q) acc[q] = w.acc[members[q]];
+  lam.assign(rows.size(), 0.0);
+  Akk.resize(rows.size());
+  for (std::size_t k = 0; k < rows.size(); ++k) Akk[k] = inv(rows[k].a) + inv(rows[k].b);
+  const auto rel = [&](const Row& r) {
+    const Vec2 ab = r.b < 0 ? Vec2{} : acc[static_cast<std::size_t>(r.b)];
+    const Vec2 aa = r.a < 0 ? Vec2{} : acc[static_cast<std::size_t>(r.a)];
+    return dot(ab - aa, r.d);
+  };
+  double amax = 0.0;
+  for (std::size_t q = 0; q < members.size(); ++q) amax = std::max(amax, length(acc[q]));
+  for (int iter = 0; iter < 20000; ++iter) {
+    double change = 0.0;
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const Row& r = rows[k];
+      if (!(Akk[k] > 0.0)) continue;
+      const double wk = rel(r);
+      double l;
+      if (r.tangent) {
+        const double bound = gc[r.c].mu * lam[k - 1];
+        l = std::clamp(lam[k] - wk / Akk[k], -bound, bound);
+      } else {
+        l = std::max(0.0, lam[k] - wk / Akk[k]);
+      }
+      const double dl = l - lam[k];
+      if (dl == 0.0) continue;
+      lam[k] = l;
+      if (r.a >= 0) acc[static_cast<std::size_t>(r.a)] -= (dl * inv(r.a)) * r.d;
+      if (r.b >= 0) acc[static_cast<std::size_t>(r.b)] += (dl * inv(r.b)) * r.d;
+      change = std::max(change, std::fabs(dl) * Akk[k]);
+    }
+    if (change <= 1e-14 * amax) break;
+  }
+  for (std::size_t q = 0; q < members.size(); ++q) {
+    if (length(acc[q]) > 1e-9 * length(w.acc[members[q]])) return false;
+  }
+  // Held, all of them, where they are at t.
+  for (std::size_t q = 0; q < members.size(); ++q) {
+    const std::uint32_t m = members[q];
+    w.advance(m, t);
+    release_support(w, m);
+    w.vel[m] = {};
+    w.apath[m] = {};
+    w.support[m] = kHeld;
+    w.support_n[m] = (-1.0 / length(w.acc[m])) * w.acc[m];
+  }
+  for (const GroupContact& c : gc) {
+    w.held.push_back({c.other_b, c.other_a, c.n});
+    if (c.a >= 0) w.held.push_back({c.other_a, c.other_b, -c.n});
+  }
+  return true;
+}
+
+bool hold_wedged(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near) {
+  if (!w.dynamic(i) || w.is_held(i) || w.acc.empty()) return false;
+  const double amag = length(w.acc[i]);
+  if (!(amag > 0.0) || length(w.vel[i]) > w.rest_speed(amag, dt)) return false;
+  thread_local std::vector<HeldContact> contacts;
+  thread_local std::vector<double> mu;
+  contacts.clear();
+  mu.clear();
+  touching_supports(w, i, near, contacts, mu);
+  if (contacts.empty()) return false;
+  release_support(w, i);
+  w.vel[i] = {};
+  w.apath[i] = {};
+  w.support[i] = kHeld;
+  w.support_n[i] = (-1.0 / amag) * w.acc[i];
+  w.held.insert(w.held.end(), contacts.begin(), contacts.end());
+  return true;
+}
+
+std::vector<RestingContact> resting_contacts(const World& w) {
+  std::vector<RestingContact> out;
+  if (w.support.empty()) return out;
+  const std::size_t n = w.size();
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (!w.alive(i) || !w.stuck(i) || w.is_held(i)) continue;
+    out.push_back({i, w.on_body(i) ? (w.support[i] & ~kBodySupport) : (kBodySupport | w.support[i]), w.support_n[i], 0.0});
+  }
+  for (const HeldContact& c : w.held) {
+    // A pair of held bodies appears once per body: keep the one from the larger index.
+    if (!(c.other & kBodySupport) && w.is_held(c.other) && c.other > c.body) continue;
+    out.push_back({c.body, c.other, c.n, 0.0});
+  }
+  // Accelerations of the bodies at rest under their forces and the contact forces.
+  std::vector<Vec2> acc(n);
+  std::vector<std::uint8_t> rest(n, 0);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (w.alive(i) && w.stuck(i)) {
+      rest[i] = 1;
+      acc[i] = w.acc[i];
+    }
+  }
+  const auto moving = [&](std::uint32_t x) { return !(x & kBodySupport) && x < n && rest[x]; };
+  const auto inv = [&](std::uint32_t x) { return moving(x) ? w.inv_mass[x] : 0.0; };
+  double amax = 0.0;
+  for (std::uint32_t i = 0; i < n; ++i) amax = std::max(amax, length(acc[i]));
+  for (int iter = 0; iter < 200000; ++iter) {
+    double change = 0.0;
+    for (RestingContact& c : out) {
+      const double akk = inv(c.body) + inv(c.other);
+      if (!(akk > 0.0)) continue;
+      const Vec2 ao = moving(c.other) ? acc[c.other] : Vec2{};
+      const double wk = dot(acc[c.body] - ao, c.n);
+      const double f = std::max(0.0, c.force - wk / akk);
+      const double df = f - c.force;
+      if (df == 0.0) continue;
+      c.force = f;
+      acc[c.body] += (df * inv(c.body)) * c.n;
+      if (moving(c.other)) acc[c.other] -= (df * inv(c.other)) * c.n;
+      change = std::max(change, std::fabs(df) * akk);
+    }
+    if (change <= 1e-15 * amax) break;
+  }
+  return out;
+}
+
+void unhold(World& w, std::uint32_t i) { release_support(w, i); }
+
+void held_on(const World& w, std::uint32_t j, std::vector<std::uint32_t>& out) {
+  for (const HeldContact& c : w.held) {
+    if (c.other == j && std::find(out.begin(), out.end(), c.body) == out.end()) out.push_back(c.body);
+  }
+}
+
+namespace {
+
 // A body touching a face, pressed into it and not moving away, settles onto it at the
 // start of the step (so that even explicit Euler, which applies a force only at the
 // end of a step, never pulls a resting body into its support).
@@ -142,9 +626,106 @@ void detect_support(World& w, std::uint32_t i, const StepContext& ctx) {
   }
 }
 
+// The stationary bodies near a point: a uniform grid over them, rebuilt per pass.
+class NearGrid {
+ public:
+  void build(const World& w, double cell) {
+    cell_ = cell;
+    keyed_.clear();
+    for (std::uint32_t j = 0; j < w.size(); ++j) {
+      if (w.alive(j) && w.stationary(j)) keyed_.push_back({key(w.pos[j]), j});
+    }
+    std::sort(keyed_.begin(), keyed_.end());
+  }
+  void query(Vec2 p, std::vector<std::uint32_t>& out) const {
+    out.clear();
+    const auto cx = static_cast<std::int64_t>(std::floor(p.x / cell_));
+    const auto cy = static_cast<std::int64_t>(std::floor(p.y / cell_));
+    for (std::int64_t dx = -1; dx <= 1; ++dx) {
+      for (std::int64_t dy = -1; dy <= 1; ++dy) {
+        const std::uint64_t k = pack(cx + dx, cy + dy);
+        auto it = std::lower_bound(keyed_.begin(), keyed_.end(), std::pair<std::uint64_t, std::uint32_t>{k, 0});
+        for (; it != keyed_.end() && it->first == k; ++it) out.push_back(it->second);
+      }
+    }
+  }
+
+ private:
+  static std::uint64_t pack(std::int64_t x, std::int64_t y) {
+    return (static_cast<std::uint64_t>(x) << 32) ^ static_cast<std::uint32_t>(y);
+  }
+  std::uint64_t key(Vec2 p) const {
+    return pack(static_cast<std::int64_t>(std::floor(p.x / cell_)), static_cast<std::int64_t>(std::floor(p.y / cell_)));
+  }
+  double cell_ = 1.0;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed_;
+};
+
+std::uint32_t held_partner_key(const World& w, const HeldContact& c) {
+  return (c.other & kBodySupport) ? static_partner_key(w.statics.segments[c.other & ~kBodySupport].owner) : c.other;
+}
+
+// Held bodies are judged again against what they touch now (their supports may have
+// gone); free slow bodies that their contacts can hold are held. Returns whether any
+// body changed. Bodies freed here follow their free path for the step.
+bool hold_pass(World& w, const StepContext& ctx) {
+  const std::size_t n = w.size();
+  double rmax = 0.0;
+  bool any = false;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (!w.alive(i)) continue;
+    rmax = std::max(rmax, w.radius[i]);
+    if (w.is_held(i) || (w.dynamic(i) && (!w.supported(i) || !w.stuck(i)))) any = true;
+  }
+  if (!any) return false;
+  thread_local NearGrid grid;
+  thread_local std::vector<std::uint32_t> near;
+  grid.build(w, std::max(2.0 * rmax, 1e-6 * w.length_scale) * (1.0 + 1e-6));
+  bool changed = false;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (!w.is_held(i)) continue;
+    unhold(w, i);
+    w.apath[i] = {};
+    grid.query(w.pos[i], near);
+    if (try_hold(w, i, ctx.dt, near)) {
+      for (const HeldContact& c : w.held) {
+        if (c.body == i) touch_contact(w, i, held_partner_key(w, c), ctx.t0);
+      }
+      continue;
+    }
+    w.apath[i] = w.acc[i];
+    changed = true;
+    w.released.clear();
+    collect_dependents(w, i);
+    for (std::uint32_t d : w.released) release_support(w, d);
+  }
+  if (changed) grid.build(w, std::max(2.0 * rmax, 1e-6 * w.length_scale) * (1.0 + 1e-6));
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (!w.dynamic(i)) continue;
+    // Free, or at rest on its face and driven along it (the face alone cannot hold it: a
+    // second may). A body sliding on its face keeps sliding to its exact stop event.
+    const bool driven = w.supported(i) && !w.on_body(i) && w.vel[i] == Vec2{} &&
+                        (w.apath[i].x != 0.0 || w.apath[i].y != 0.0);
+    if (w.supported(i) && !driven) continue;
+    grid.query(w.pos[i], near);
+    if (!try_hold(w, i, ctx.dt, near)) continue;
+    changed = true;
+    for (const HeldContact& c : w.held) {
+      if (c.body != i) continue;
+      if (c.other & kBodySupport) {
+        record_contact(w, i, kNone, &w.statics.segments[c.other & ~kBodySupport], ctx.t0, ctx.dt);
+      } else {
+        record_contact(w, i, c.other, nullptr, ctx.t0, ctx.dt);
+      }
+    }
+  }
+  return changed;
+}
+
 }  // namespace
 
 void apply_supports(World& w, const StepContext& ctx) {
+  w.step_dt = ctx.dt;
   const std::size_t n = w.size();
   for (std::uint32_t i = 0; i < n; ++i) {
     if (w.support[i] == kNone) {
@@ -179,7 +760,7 @@ void apply_supports(World& w, const StepContext& ctx) {
   for (bool changed = true; changed;) {
     changed = false;
     for (std::uint32_t i = 0; i < n; ++i) {
-      if (!w.on_body(i)) continue;
+      if (!w.on_body(i) || w.is_held(i)) continue;
       const std::uint32_t j = w.support[i] & ~kBodySupport;
       const Vec2 d = w.pos[i] - w.pos[j];
       const double dist = length(d);
@@ -198,6 +779,7 @@ void apply_supports(World& w, const StepContext& ctx) {
         changed = true;
       }
     }
+    if (hold_pass(w, ctx)) changed = true;
   }
 }
 

@@ -33,6 +33,7 @@ namespace {
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 constexpr double kGapUlps = 1024.0;
 constexpr std::size_t kMaxContacts = 256;
+constexpr std::uint32_t kSegmentContact = kSimultaneousFace;
 
 double inf_norm(Vec2 v) { return std::max(std::fabs(v.x), std::fabs(v.y)); }
 
@@ -41,6 +42,8 @@ struct Contact {
   Vec2 n;
   double target = 0.0;
   double p = 0.0;
+  double mu_s = 0.0, mu_k = 0.0;   // friction: the tangential impulse is at most mu p
+  double pt = 0.0;                 // tangential impulse along perp(n)
   double vscale = 0.0;   // |v_a| + |v_b| before
 };
 
@@ -66,43 +69,115 @@ bool touching(const World& w, std::uint32_t i, std::uint32_t j, double t, Contac
   return true;
 }
 
-bool eligible_body(const World& w, std::uint32_t i) {
+// Whether body i touches face k of a segment at t, at rest or closing; fills the contact
+// (a = kSegmentContact | k, n from the face to the body).
+bool touching_face(const World& w, std::uint32_t i, std::uint32_t k, double t, Contact& c) {
+  const Segment& s = w.statics.segments[k];
+  const Vec2 p = w.pos_at(i, t);
+  const double u = dot(p - s.from, s.dir);
+  if (u < 0.0 || u > s.length) return false;
+  const double D = dot(p - s.from, s.normal);
+  const double scale = inf_norm(p) + w.radius[i] + inf_norm(s.from) + inf_norm(s.to);
+  if (std::fabs(D) - w.radius[i] > kGapUlps * kEps * scale) return false;
+  const Vec2 n = D >= 0.0 ? s.normal : -s.normal;
+  const Vec2 v = w.vel_at(i, t);
+  const double vscale = length(v);
+  if (dot(v, n) > kGapUlps * kEps * vscale) return false;
+  c.a = kSegmentContact | k;
+  c.b = i;
+  c.n = n;
+  c.vscale = vscale;
+  return true;
+}
+
+// A body that can take part: a body at rest on its supports (held, or stuck on a face
+// or a body) too, with its faces (fixed when `fixed_rest`: the impact is slower than the
+// collapse speed, so its supports absorb it); a body sliding on a face never.
+bool eligible_body(const World& w, std::uint32_t i, bool fixed_rest) {
   if (!w.alive(i)) return false;
   if (w.flags[i] & (kParticle | kPoint)) return false;
-  if (w.supported(i)) return false;
+  if (w.supported(i)) return w.stationary(i);
   return true;
+}
+
+// Does not move in this impact: static, or at rest on its supports in a slow impact.
+bool fixed(const World& w, std::uint32_t i, bool fixed_rest) {
+  return w.is_static(i) || (fixed_rest && w.stationary(i));
 }
 
 }  // namespace
 
 bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t,
-                          std::vector<std::uint32_t>& bodies, std::vector<BodyPair>& impacted) {
+                          std::vector<std::uint32_t>& bodies, std::vector<BodyPair>& impacted, double seed_min_sep) {
   if (w.impact_law != ImpactLaw::Simultaneous || w.any_rules) return false;
-  if (!eligible_body(w, i0) || !eligible_body(w, j0)) return false;
+  const bool face_seed = (j0 & kSegmentContact) != 0;
+  // A slow seed impact (below the collapse speed) meets bodies at rest as fixed ones.
+  bool fixed_rest = false;
+  if (!w.acc.empty()) {
+    const Vec2 vj = face_seed ? Vec2{} : w.vel_at(j0, t);
+    fixed_rest = length(vj - w.vel_at(i0, t)) < w.collapse_speed(i0, face_seed ? i0 : j0);
+  }
+  if (!eligible_body(w, i0, fixed_rest) || (!face_seed && !eligible_body(w, j0, fixed_rest))) return false;
+  if (fixed(w, i0, fixed_rest) && (face_seed || fixed(w, j0, fixed_rest))) return false;
   // Scratch kept between calls: an isolated impact (the common case) allocates nothing.
   thread_local std::vector<Contact> contacts;
   thread_local std::vector<std::uint32_t> found;
   thread_local std::vector<double> A, w0;
   contacts.clear();
   bodies.clear();
-  bodies.push_back(std::min(i0, j0));
-  bodies.push_back(std::max(i0, j0));
+  if (face_seed) {
+    bodies.push_back(i0);
+  } else {
+    bodies.push_back(std::min(i0, j0));
+    bodies.push_back(std::max(i0, j0));
+  }
+  const auto add = [&](Contact& c, double restitution, double mu_s, double mu_k) {
+    c.mu_s = std::max(mu_s, mu_k);
+    c.mu_k = mu_k;
+    const double wn = dot(w.vel_at(c.b, t) - ((c.a & kSegmentContact) ? Vec2{} : w.vel_at(c.a, t)), c.n);
+    const std::uint32_t other = (c.a & kSegmentContact) ? c.b : c.a;
+    const double e = -wn < w.collapse_speed(other, c.b) ? 0.0 : restitution;
+    c.target = std::max(-e * wn, 0.0);
+    const bool seed = face_seed ? (c.a == j0 && c.b == i0) : (c.a == std::min(i0, j0) && c.b == std::max(i0, j0));
+    if (seed) c.target = std::max(c.target, seed_min_sep);
+    contacts.push_back(c);
+  };
   // Adds contact (i, j) if the two touch; false if the set must go pair by pair.
   const auto consider = [&](std::uint32_t i, std::uint32_t j) {
-    if (j == i || !eligible_body(w, j)) return true;
-    if (w.is_static(i) && w.is_static(j)) return true;
+    if (j == i || !eligible_body(w, j, fixed_rest)) return true;
+    if (fixed(w, i, fixed_rest) && fixed(w, j, fixed_rest)) return true;
     Contact c;
     if (!touching(w, i, j, t, c)) return true;
     const bool known = std::any_of(contacts.begin(), contacts.end(),
                                    [&](const Contact& k) { return k.a == c.a && k.b == c.b; });
     if (known) return true;
     const PairMaterial m = w.pair_material(w.material[c.a], w.material[c.b]);
-    if (m.friction > 0.0 || m.static_friction > 0.0) return false;
-    const double wn = dot(w.vel_at(c.b, t) - w.vel_at(c.a, t), c.n);
-    c.target = std::max(-m.restitution * wn, 0.0);
-    contacts.push_back(c);
+    add(c, m.restitution, m.static_friction, m.friction);
     if (contacts.size() > kMaxContacts) return false;
     if (std::find(bodies.begin(), bodies.end(), j) == bodies.end()) bodies.push_back(j);
+    return true;
+  };
+  // The faces body i touches; false if one has interpolated normals (a surface: its own
+  // response).
+  const auto consider_faces = [&](std::uint32_t i) {
+    if (w.statics.segments.empty() || fixed(w, i, fixed_rest)) return true;
+    const Vec2 p = w.pos_at(i, t);
+    const double pad = w.radius[i] * (1.0 + 1e-9) + kGapUlps * kEps * (inf_norm(p) + w.length_scale);
+    w.found_static.clear();
+    w.statics.query(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), w.found_static);
+    std::sort(w.found_static.begin(), w.found_static.end());
+    for (std::uint32_t k : w.found_static) {
+      Contact c;
+      if (!touching_face(w, i, k, t, c)) continue;
+      const Segment& s = w.statics.segments[k];
+      if (s.normal_from.x != 0.0 || s.normal_from.y != 0.0) return false;
+      const bool known = std::any_of(contacts.begin(), contacts.end(),
+                                     [&](const Contact& x) { return x.a == c.a && x.b == c.b; });
+      if (known) continue;
+      const PairMaterial m = w.pair_material(w.material[i], s.material);
+      add(c, m.restitution, m.static_friction, m.friction);
+      if (contacts.size() > kMaxContacts) return false;
+    }
     return true;
   };
   const auto touch_box = [&](std::uint32_t i) {
@@ -110,71 +185,220 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     const double pad = kGapUlps * kEps * (inf_norm(p) + 2.0 * w.radius[i] + 1.0) + w.radius[i];
     return make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad);
   };
+  // A body at rest on its supports takes part with its faces only: the set does not
+  // spread through a pile at rest (its other contacts meet it pair by pair if it moves).
+  const auto leaf = [&](std::uint32_t i) { return w.supported(i) && w.stationary(i) && !fixed(w, i, fixed_rest); };
   // The impacting pair first, with one broad-phase query for both (an isolated impact,
   // the common case, pays only this); then breadth-first over the rest of the set.
   // Static bodies end the set (nothing moves them).
-  const std::uint32_t first = bodies[0], second = bodies[1];
-  found.clear();
-  w.bp->query_box(merge(touch_box(first), touch_box(second)), kNone, found);
-  std::sort(found.begin(), found.end());
-  for (std::uint32_t j : found) {
-    if (!w.is_static(first) && !consider(first, j)) return false;
-    if (!w.is_static(second) && !consider(second, j)) return false;
+  std::size_t q = 0;
+  if (face_seed) {
+    if (!consider_faces(i0)) return false;
+    q = 0;
+  } else {
+    const std::uint32_t first = bodies[0], second = bodies[1];
+    found.clear();
+    w.bp->query_box(merge(touch_box(first), touch_box(second)), kNone, found);
+    std::sort(found.begin(), found.end());
+    for (std::uint32_t j : found) {
+      if (!fixed(w, first, fixed_rest) && !leaf(first) && !consider(first, j)) return false;
+      if (!fixed(w, second, fixed_rest) && !leaf(second) && !consider(second, j)) return false;
+    }
+    // One contact so far and no faces: an isolated impact, the pairwise law's.
+    if (!consider_faces(first) || !consider_faces(second)) return false;
+    q = 2;
   }
-  for (std::size_t q = 2; q < bodies.size(); ++q) {
+  for (; q < bodies.size(); ++q) {
     const std::uint32_t i = bodies[q];
-    if (w.is_static(i)) continue;
+    if (fixed(w, i, fixed_rest)) continue;
+    if (leaf(i)) {
+      if (!consider_faces(i)) return false;
+      continue;
+    }
     found.clear();
     w.bp->query_box(touch_box(i), i, found);
     std::sort(found.begin(), found.end());
     for (std::uint32_t j : found) {
       if (!consider(i, j)) return false;
     }
+    if (q > 1 || face_seed) {
+      if (!consider_faces(i)) return false;
+    }
   }
   if (contacts.size() < 2) return false;   // one contact: the pairwise law is the same
 
   for (std::uint32_t b : bodies) w.advance(b, t);
-  // Delassus matrix, dense (the set is small).
+  // Rows: each contact's normal, and its tangent when it has friction. Delassus matrix
+  // over the rows, dense (the set is small).
+  struct Row {
+    std::uint32_t a, b;
+    Vec2 d;
+    std::size_t contact;
+    bool tangent;
+  };
+  thread_local std::vector<Row> rows;
+  thread_local std::vector<double> p;
+  rows.clear();
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const Contact& c = contacts[k];
+    rows.push_back({c.a, c.b, c.n, k, false});
+    if (c.mu_s > 0.0) rows.push_back({c.a, c.b, perp(c.n), k, true});
+  }
   const std::size_t K = contacts.size();
-  A.assign(K * K, 0.0);
-  w0.assign(K, 0.0);
-  for (std::size_t k = 0; k < K; ++k) {
-    const Contact& ck = contacts[k];
-    w0[k] = dot(w.vel[ck.b] - w.vel[ck.a], ck.n);
-    for (std::size_t l = 0; l < K; ++l) {
-      const Contact& cl = contacts[l];
-      const double nn = dot(ck.n, cl.n);
-      double s = 0.0;
-      if (ck.a == cl.a) s += w.inv_mass[ck.a] * nn;
-      if (ck.b == cl.b) s += w.inv_mass[ck.b] * nn;
-      if (ck.a == cl.b) s -= w.inv_mass[ck.a] * nn;
-      if (ck.b == cl.a) s -= w.inv_mass[ck.b] * nn;
-      A[k * K + l] = s;
+  const std::size_t R = rows.size();
+  w0.assign(R, 0.0);
+  p.assign(R, 0.0);
+  const auto inv = [&](std::uint32_t x) {
+    return (x & kSegmentContact) || fixed(w, x, fixed_rest) ? 0.0 : w.inv_mass[x];
+  };
+  const auto vel = [&](std::uint32_t x) { return (x & kSegmentContact) ? Vec2{} : w.vel[x]; };
+  // Each row reads and writes its bodies' velocity changes (dv), so a sweep costs O(R),
+  // not O(R^2): slot[] maps a row's bodies into dv (faces: none).
+  thread_local std::vector<Vec2> dv;
+  thread_local std::vector<std::int32_t> slot_a, slot_b;
+  dv.assign(bodies.size(), Vec2{});
+  slot_a.assign(R, -1);
+  slot_b.assign(R, -1);
+  const auto slot_of = [&](std::uint32_t x) -> std::int32_t {
+    if (x & kSegmentContact) return -1;
+    return static_cast<std::int32_t>(std::find(bodies.begin(), bodies.end(), x) - bodies.begin());
+  };
+  A.assign(R, 0.0);   // the diagonal
+  for (std::size_t k = 0; k < R; ++k) {
+    const Row& rk = rows[k];
+    w0[k] = dot(vel(rk.b) - vel(rk.a), rk.d);
+    A[k] = inv(rk.a) + inv(rk.b);
+    slot_a[k] = slot_of(rk.a);
+    slot_b[k] = slot_of(rk.b);
+  }
+  const auto solve_exactly = [&](const auto& rws, const auto& cts, const std::vector<double>& w00,
+                                 std::vector<double>& pp, const auto& invf) {
+    const std::size_t n = rws.size();
+    double M[6][6];
+    for (std::size_t k = 0; k < n; ++k) {
+      for (std::size_t l = 0; l < n; ++l) {
+        const double nn = dot(rws[k].d, rws[l].d);
+        double v = 0.0;
+        if (rws[k].a == rws[l].a) v += invf(rws[k].a) * nn;
+        if (rws[k].b == rws[l].b) v += invf(rws[k].b) * nn;
+        if (rws[k].a == rws[l].b) v -= invf(rws[k].a) * nn;
+        if (rws[k].b == rws[l].a) v -= invf(rws[k].b) * nn;
+        M[k][l] = v;
+      }
+    }
+    std::vector<unsigned> order;
+    for (unsigned m = 1; m < (1u << n); ++m) order.push_back(m);
+    std::stable_sort(order.begin(), order.end(),
+                     [](unsigned x, unsigned y) { return __builtin_popcount(x) > __builtin_popcount(y); });
+    for (unsigned mask : order) {
+      std::size_t idx[6], m = 0;
+      for (std::size_t k = 0; k < n; ++k) {
+        if (mask & (1u << k)) idx[m++] = k;
+      }
+      double G[6][7];
+      for (std::size_t r = 0; r < m; ++r) {
+        for (std::size_t c = 0; c < m; ++c) G[r][c] = M[idx[r]][idx[c]];
+        G[r][m] = cts[rws[idx[r]].contact].target - w00[idx[r]];
+      }
+      bool singular = false;
+      for (std::size_t c = 0; c < m && !singular; ++c) {
+        std::size_t piv = c;
+        for (std::size_t r = c + 1; r < m; ++r) {
+          if (std::fabs(G[r][c]) > std::fabs(G[piv][c])) piv = r;
+        }
+        if (!(std::fabs(G[piv][c]) > 1e-300)) {
+          singular = true;
+          break;
+        }
+        for (std::size_t q = 0; q <= m; ++q) std::swap(G[c][q], G[piv][q]);
+        for (std::size_t r = 0; r < m; ++r) {
+          if (r == c) continue;
+          const double f = G[r][c] / G[c][c];
+          for (std::size_t q = c; q <= m; ++q) G[r][q] -= f * G[c][q];
+        }
+      }
+      if (singular) continue;
+      double x[6] = {0, 0, 0, 0, 0, 0};
+      bool ok = true;
+      for (std::size_t r = 0; r < m; ++r) {
+        x[idx[r]] = G[r][m] / G[r][r];
+        if (x[idx[r]] < 0.0) ok = false;
+      }
+      if (!ok) continue;
+      for (std::size_t k = 0; k < n && ok; ++k) {
+        if (mask & (1u << k)) continue;
+        double wk = w00[k];
+        for (std::size_t l = 0; l < n; ++l) wk += M[k][l] * x[l];
+        const double scale = std::fabs(w00[k]) + std::fabs(cts[rws[k].contact].target) + 1e-300;
+        if (wk < cts[rws[k].contact].target - kGapUlps * kEps * scale) ok = false;
+      }
+      if (!ok) continue;
+      for (std::size_t k = 0; k < n; ++k) pp[k] = x[k];
+      return true;
+    }
+    return false;
+  };
+  // A small frictionless set is solved exactly: the first complementary active set
+  // (largest first) whose impulses are >= 0 and whose other contacts separate. PGS
+  // would crawl when masses differ by 1e9 (its rate is 1 - m_light / m_heavy).
+  bool solved = false;
+  if (R == K && K <= 6) solved = solve_exactly(rows, contacts, w0, p, inv);
+  // Projected Gauss-Seidel to round-off: normal impulses >= 0 reaching their targets,
+  // tangential ones stopping the sliding within the static friction bound mu_s p_n.
+  // With friction the sweeps can trade round-off for ever: at most 2000 of them then.
+  const bool friction = R > K;
+  const int max_iter = friction ? 2000 : 100000;
+  const double stop = 4.0 * kEps;
+  double pmax = 0.0;
+  for (int iter = 0; iter < max_iter && !solved; ++iter) {
+    double change = 0.0;
+    for (std::size_t k = 0; k < R; ++k) {
+      const double akk = A[k];
+      if (!(akk > 0.0)) continue;
+      const Row& rk = rows[k];
+      const Vec2 da = slot_a[k] >= 0 ? dv[static_cast<std::size_t>(slot_a[k])] : Vec2{};
+      const Vec2 db = slot_b[k] >= 0 ? dv[static_cast<std::size_t>(slot_b[k])] : Vec2{};
+      const double wk = w0[k] + dot(db - da, rk.d);
+      double pk;
+      if (rk.tangent) {
+        const double bound = contacts[rk.contact].mu_s * p[k - 1];
+        pk = std::clamp(p[k] - wk / akk, -bound, bound);
+      } else {
+        pk = std::max(0.0, p[k] + (contacts[rk.contact].target - wk) / akk);
+      }
+      const double dp = pk - p[k];
+      if (dp != 0.0) {
+        if (slot_a[k] >= 0) dv[static_cast<std::size_t>(slot_a[k])] -= (dp * inv(rk.a)) * rk.d;
+        if (slot_b[k] >= 0) dv[static_cast<std::size_t>(slot_b[k])] += (dp * inv(rk.b)) * rk.d;
+      }
+      change = std::max(change, std::fabs(dp));
+      p[k] = pk;
+      pmax = std::max(pmax, std::fabs(pk));
+    }
+    if (change <= stop * pmax) break;
+  }
+  // A contact whose friction could not stop it slides: kinetic friction, mu_k p_n.
+  for (std::size_t k = 0; k < R; ++k) {
+    const Row& rk = rows[k];
+    if (!rk.tangent) continue;
+    const Contact& c = contacts[rk.contact];
+    if (std::fabs(p[k]) >= c.mu_s * p[k - 1] * (1.0 - 1e-12) && c.mu_k < c.mu_s) {
+      p[k] = std::copysign(c.mu_k * p[k - 1], p[k]);
     }
   }
-  // Projected Gauss-Seidel to round-off.
-  double pmax = 0.0;
-  for (int iter = 0; iter < 100000; ++iter) {
-    double change = 0.0;
-    for (std::size_t k = 0; k < K; ++k) {
-      const double akk = A[k * K + k];
-      if (!(akk > 0.0)) continue;
-      double wk = w0[k];
-      for (std::size_t l = 0; l < K; ++l) wk += A[k * K + l] * contacts[l].p;
-      const double pk = std::max(0.0, contacts[k].p + (contacts[k].target - wk) / akk);
-      change = std::max(change, std::fabs(pk - contacts[k].p));
-      contacts[k].p = pk;
-      pmax = std::max(pmax, pk);
-    }
-    if (change <= 4.0 * kEps * pmax) break;
+  for (std::size_t k = 0; k < R; ++k) {
+    const Row& rk = rows[k];
+    if (rk.tangent) contacts[rk.contact].pt = p[k];
+    else contacts[rk.contact].p = p[k];
   }
   impacted.clear();
   for (const Contact& c : contacts) {
     // An impact: a velocity change above round-off (a pair touching at equal speeds
     // meets again at once through round-off, and takes an impulse of that size).
-    if (c.p * (w.inv_mass[c.a] + w.inv_mass[c.b]) > kGapUlps * kEps * c.vscale) impacted.push_back({c.a, c.b});
-    w.vel[c.a] -= (c.p * w.inv_mass[c.a]) * c.n;
-    w.vel[c.b] += (c.p * w.inv_mass[c.b]) * c.n;
+    if (c.p * (inv(c.a) + inv(c.b)) > kGapUlps * kEps * c.vscale) impacted.push_back({c.a, c.b});
+    const Vec2 P = c.p * c.n + c.pt * perp(c.n);
+    if (!(c.a & kSegmentContact)) w.vel[c.a] -= inv(c.a) * P;
+    w.vel[c.b] += inv(c.b) * P;
   }
   w.stats.impacts += static_cast<std::int64_t>(K) - 1;
   return true;

@@ -134,6 +134,11 @@ double entry(const Poly& g, double T, Tolerance tol, bool allow_now) {
     // Touching at 0 but not closing (just resolved): a dip within the touch tolerance
     // right after 0 is round-off, not a new impact.
     const double entry_level = (allow_now && i == 0) ? std::max(tol.touch, 0.0) : 0.0;
+    // Touching at 0 and parting too little to leave the touch tolerance before turning
+    // back: the pair closes again from the turn. (Without this, a pair that starts a
+    // round-off overlap apart and parts slowly while pressed together is never found
+    // again, and sinks into each other.)
+    if (allow_now && i == 0 && g0 <= tol.touch && i < nb && fhi > flo && fhi <= tol.touch) return hi;
     if (flo > entry_level && fhi <= 0.0) {
       if (deg <= 2) {
         double r[2];

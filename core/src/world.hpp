@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <unordered_map>
 #include <limits>
 #include <memory>
@@ -29,6 +30,16 @@ const char* integrator_name(Integrator i);
 inline constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 // support[i] names a segment, or with this bit a body (a body at rest on a body).
 inline constexpr std::uint32_t kBodySupport = 0x80000000u;
+// support[i] == kHeld: at rest, held by several contacts at once (World::held). It has
+// the body bit, so on_body() and stuck() treat it as a body at rest on bodies.
+inline constexpr std::uint32_t kHeld = 0xFFFFFFFEu;
+
+// One contact of a held body: `other` is a body, or kBodySupport | segment index.
+struct HeldContact {
+  std::uint32_t body = 0;
+  std::uint32_t other = 0;
+  Vec2 n;   // unit, from the other towards the body
+};
 
 enum BodyFlag : std::uint8_t {
   kAlive = 1,
@@ -161,6 +172,7 @@ struct World {
   std::vector<Vec2> support_n;          // unit, from the support towards the body
   std::vector<std::uint32_t> dep_head, dep_next;   // any_forces: bodies resting on each body (a list)
   std::vector<std::uint32_t> released;             // scratch: bodies freed by their support moving
+  std::vector<HeldContact> held;                   // any_forces: the contacts of every held body
   // any_forces: contact continuity, per pair: contact_key(i, partner) -> the last time
   // the pair touched (an impact, or resting on each other at a step's end).
   std::unordered_map<std::uint64_t, double> last_touch;
@@ -219,6 +231,9 @@ struct World {
   bool dynamic(std::uint32_t i) const { return (flags[i] & (kAlive | kStatic)) == kAlive; }
   bool supported(std::uint32_t i) const { return !support.empty() && support[i] != kNone; }
   bool on_body(std::uint32_t i) const { return supported(i) && (support[i] & kBodySupport) != 0; }
+  bool is_held(std::uint32_t i) const { return !support.empty() && support[i] == kHeld; }
+  // Does not move for the rest of the step: static, or at rest on its supports.
+  bool stationary(std::uint32_t i) const { return is_static(i) || stuck(i); }
   // At rest on a support: not moving, and held there for the rest of the step.
   bool stuck(std::uint32_t i) const {
     return supported(i) && vel[i].x == 0.0 && vel[i].y == 0.0 && apath[i].x == 0.0 && apath[i].y == 0.0;
@@ -267,6 +282,14 @@ struct World {
   double rest_speed(double a_n, double dt) const {
     return rest_speed_option > 0.0 ? rest_speed_option : rest_factor * std::abs(a_n) * dt;
   }
+  // Inelastic collapse: an impact of bodies i and j closing slower than this is
+  // perfectly inelastic (restitution falls to 0): the rest speed of the larger of their
+  // accelerations. 0 in a scene without forces.
+  double step_dt = 0.0;   // the current step's dt (set by apply_supports)
+  double collapse_speed(std::uint32_t i, std::uint32_t j) const {
+    if (acc.empty() || step_dt == 0.0) return 0.0;
+    return rest_speed(std::max(length(acc[i]), length(acc[j])), step_dt);
+  }
   std::size_t memory_bytes() const;
 };
 
@@ -311,6 +334,42 @@ void rest_on_body(World& w, std::uint32_t i, std::uint32_t j, Vec2 n);
 bool can_rest_on(const World& w, std::uint32_t i, std::uint32_t j, Vec2 n, double rest_speed);
 // Appends the bodies resting on j, and on those in turn, to w.released.
 void collect_dependents(World& w, std::uint32_t j);
+// Several supports at once (resting_contact.cpp). Body i, slow (|v| <= the rest speed
+// of its acceleration), is held at rest if the stationary bodies and faces it touches
+// can balance its force: -a lies in the cone spanned by their normals widened by their
+// static friction cones. Then its velocity goes to 0, support[i] = kHeld and its
+// contacts are recorded. `near`: bodies that may touch it (others are ignored).
+// With settle_into_pocket, a body touching one support and within rest_speed x dt of a
+// second is also held where the two meet, if they hold it there (the limit of its
+// inelastic collapse into that pocket).
+bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near,
+              bool settle_into_pocket = false);
+// A group: the slow free bodies touching body `seed` at time t (within the step), and
+// those touching them, held at rest together if forces within their static friction
+// cones (normal forces >= 0) can hold every one of them still (an acceleration-level
+// contact problem, projected Gauss-Seidel). near_fn(p, pad, out) lists the bodies whose
+// boxes meet the square of half-side pad around p.
+using NearFn = std::function<void(Vec2, double, std::vector<std::uint32_t>&)>;
+bool try_hold_group(World& w, std::uint32_t seed, double t, double dt, const NearFn& near_fn,
+                    std::vector<std::uint32_t>& members);
+// A slow body wedged among stationary bodies and faces (no impulse moves it, so the
+// same impact would recur at the same instant for ever) is held where it is, whether
+// or not its contacts balance its force exactly; the next step judges it again.
+bool hold_wedged(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near);
+// The contacts of all bodies at rest (held, or stuck on a face or a body) with their
+// normal forces from the equilibrium of all at once (frictionless normal forces >= 0,
+// projected Gauss-Seidel to round-off).
+struct RestingContact {
+  std::uint32_t body = 0;
+  std::uint32_t other = 0;   // a body, or kBodySupport | segment
+  Vec2 n;                    // towards body
+  double force = 0.0;
+};
+std::vector<RestingContact> resting_contacts(const World& w);
+// Forgets a held body's contacts and makes it free (its path: a = acc).
+void unhold(World& w, std::uint32_t i);
+// Appends the held bodies with a contact on body j to `out`.
+void held_on(const World& w, std::uint32_t j, std::vector<std::uint32_t>& out);
 // Time within the step at which a supported body stops sliding or leaves its
 // segment, from time t (toi::kNever if not in [t, T]).
 double support_stop_time(const World& w, std::uint32_t i, double t, double T);
@@ -363,8 +422,12 @@ ImpactResult resolve_pair(World& w, std::uint32_t i, std::uint32_t j, Vec2 n, co
 // them at once, leaves every body of the set advanced to t in `bodies` and the pairs
 // that took an impulse in `impacted`, returns true.
 // Otherwise (one contact, sequential law, friction, supports, rules) changes nothing.
+// j may also be kSimultaneousFace | k: body i's impact on face k of segment k; the set
+// then includes the faces its bodies touch, and `impacted` names a face the same way.
+inline constexpr std::uint32_t kSimultaneousFace = 0x80000000u;
+// seed_min_sep: the pair (i, j) leaves at least this fast (a micro-bounce).
 bool resolve_simultaneous(World& w, std::uint32_t i, std::uint32_t j, double t, std::vector<std::uint32_t>& bodies,
-                          std::vector<BodyPair>& impacted);
+                          std::vector<BodyPair>& impacted, double seed_min_sep = 0.0);
 ImpactResult resolve_static(World& w, std::uint32_t i, Vec2 n, const PairMaterial& m,
                             double min_separation_speed);
 // Records a contact event if the contact begins (see exact_collisions.cpp) at absolute

@@ -13,6 +13,8 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "physval/core/engine.hpp"
 
@@ -31,6 +33,7 @@ struct CoreStepStats {
   std::int64_t events = 0;          // events processed (impacts, friction stops, leaving a support, ...)
   std::int64_t candidate_pairs = 0; // broad-phase pairs at the start of the step
   bool event_cap_hit = false;       // the step ended in the lecture pass (see max_events_per_step)
+  std::int64_t wedged = 0;          // slow bodies held where no impulse could move them
 };
 
 // The core engine. Construct it through core_engine_factory() or directly (tests).
@@ -61,6 +64,18 @@ class CoreEngine final : public Engine {
   double particle_intensity(std::size_t i) const;
 
   const CoreStepStats& last_step_stats() const;
+  // The normal forces at the contacts of the bodies at rest (held on several supports,
+  // or stuck on one), from the equilibrium of all of them at once: normal forces >= 0
+  // that cancel every one's force where they can (frictionless; projected Gauss-Seidel
+  // to round-off). `other` is a body index or, for a face, -1 and `wall` its owner.
+  struct RestingForce {
+    std::size_t body = 0;
+    std::int64_t other = -1;
+    ObjectRef wall;
+    Vec2 normal;        // unit, towards `body`
+    double force = 0.0; // N
+  };
+  std::vector<RestingForce> resting_forces() const;
   // Bytes of memory the engine holds (all its arrays, broad phase and queues).
   std::size_t memory_bytes() const;
 

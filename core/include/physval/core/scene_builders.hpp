@@ -17,4 +17,11 @@ Scene make_circle_gas(int n, std::uint64_t seed);
 // The side of the gas's box for n circles, m.
 double circle_gas_box_side(int n);
 
+// A pile (issue 9): n circles of radius 0.1 m and mass 1 kg with restitution e and
+// friction mu (mu_s = mu_k, walls alike) dropped under gravity (0, -9.8) into a closed
+// box of inner width 0.25 m x cols (cols = max(4, round(sqrt n))), from a jittered
+// lattice of spacing 0.25 m starting 0.15 m above the floor, with velocities uniform on
+// [-0.5, 0.5] m/s per axis; dt = 1/60 s, duration 10 s. Same seed, same scene.
+Scene make_circle_pile(int n, double restitution, double friction, std::uint64_t seed);
+
 }  // namespace physval
