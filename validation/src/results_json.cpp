@@ -118,12 +118,14 @@ json suite_to_json(const SuiteResult& result) {
       comparisons.push_back({{"scenario", p.scenario}, {"a", p.a}, {"b", p.b}, {"metrics", m}});
     }
   }
-  return {{"physval_version", PHYSVAL_VERSION},
-          {"context", context_json()},
-          {"gates_enforced", result.gates_enforced},
-          {"runs", runs},
-          {"references", references},
-          {"comparisons", comparisons}};
+  json out = {{"physval_version", PHYSVAL_VERSION},
+              {"context", context_json()},
+              {"gates_enforced", result.gates_enforced},
+              {"runs", runs},
+              {"references", references},
+              {"comparisons", comparisons}};
+  if (!result.shard.is_null()) out["shard"] = result.shard;
+  return out;
 }
 
 void write_file_atomically(const std::filesystem::path& path, const std::string& text) {

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "physval/validation/comparator.hpp"
 #include "physval/validation/run_record.hpp"
 #include "physval/validation/runner.hpp"
@@ -22,6 +24,9 @@ struct ScenarioResult {
 struct SuiteResult {
   std::vector<ScenarioResult> scenarios;
   bool gates_enforced = false;
+  // `--shard I/N`: which part of which suite this is (results.json's "shard" block, what
+  // `physval merge` checks the shards against each other with); null for a whole run.
+  nlohmann::json shard;
 };
 
 using Progress = std::function<void(const std::string& line)>;
