@@ -50,8 +50,8 @@ SeriesDivergence series_divergence(const Series& run, const Series& ref, double 
   // and agree again at the next paired sample) is left out of the energy and momentum
   // comparison; a destruction that really differs still differs at the next sample.
   auto same_alive = [&](std::size_t k) {
-    const std::vector<BodyState>& sa = run.states[k];
-    const std::vector<BodyState>& sb = ref.states[static_cast<std::size_t>(pairs[k])];
+    const SampleRow& sa = run.states[k];
+    const SampleRow& sb = ref.states[static_cast<std::size_t>(pairs[k])];
     if (sa.size() != sb.size()) return false;
     for (std::size_t i = 0; i < sa.size(); ++i) {
       if (sa[i].alive != sb[i].alive) return false;
@@ -63,8 +63,8 @@ SeriesDivergence series_divergence(const Series& run, const Series& ref, double 
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     if (pairs[k] < 0) continue;
     const auto j = static_cast<std::size_t>(pairs[k]);
-    const std::vector<BodyState>& sa = run.states[k];
-    const std::vector<BodyState>& sb = ref.states[j];
+    const SampleRow& sa = run.states[k];
+    const SampleRow& sb = ref.states[j];
     const std::size_t bodies = std::min({sa.size(), sb.size(), scene_bodies});
     for (std::size_t i = 0; i < bodies; ++i) {
       if (!sa[i].alive || !sb[i].alive) continue;

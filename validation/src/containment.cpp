@@ -59,7 +59,7 @@ Containment measure_containment(const Scene& scene, const Series& series) {
   }
   std::vector<std::size_t> order;
   for (std::size_t k = 0; k < series.states.size(); ++k) {
-    const std::vector<BodyState>& s = series.states[k];
+    const SampleRow& s = series.states[k];
     const std::size_t n = std::min(s.size(), nb);
     // Pairs, swept over x.
     order.resize(n);

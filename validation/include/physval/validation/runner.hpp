@@ -22,7 +22,7 @@ struct RunOptions {
   // isolated run stops at the earlier of its timeout and this deadline.
   std::optional<std::chrono::steady_clock::time_point> deadline;
   // Bound on stored samples x bodies (memory); the sample interval grows to fit.
-  std::size_t max_sample_states = 4'000'000;
+  std::size_t max_sample_states = 1'000'000;
   // Folder of the reference cache (see reference_cache.hpp); empty: no cache.
   std::string reference_cache;
 };
