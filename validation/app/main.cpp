@@ -253,7 +253,9 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
 
   const Progress progress = terminal_progress(o.quiet);
   const std::size_t jobs = o.jobs > 0 ? static_cast<std::size_t>(o.jobs) : default_jobs();
-  SuiteResult result = run_suite(*scenes, o.engines, options, gate, suite_progress(o.quiet, scenes->size()), jobs);
+  const bool no_scenes = scenes->empty();
+  const Progress suite_line = suite_progress(o.quiet, scenes->size());
+  SuiteResult result = run_suite(std::move(*scenes), o.engines, options, gate, suite_line, jobs);
   end_progress(progress);
   result.shard = shard_block;
   if (!baseline_path.empty()) {
@@ -270,7 +272,7 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
       return kExitBadInput;
     }
   }
-  if (gate && !(shard && scenes->empty())) {   // a shard may be left without scenarios (N > suite)
+  if (gate && !(shard && no_scenes)) {   // a shard may be left without scenarios (N > suite)
     std::size_t checked = 0;
     for (const ScenarioResult& sr : result.scenarios) {
       for (const RunRecord& r : sr.runs) checked += r.status == RunStatus::Unsupported ? 0 : 1;

@@ -321,10 +321,21 @@ Reference make_reference(const Scene& scene, const RunOptions& options) {
     ro.deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                          std::chrono::duration<double>(ro.timeout_seconds));
   }
-  const Scene fine = variant(refine);
-  const Scene coarse = variant(refine / 2);
-  RunRecord fine_run = run_engine_isolated(fine, *engine, ro);
-  RunRecord coarse_run = run_engine_isolated(coarse, *engine, ro);
+  // One variant of the scene at a time: a copy of a large scene is hundreds of bytes a body.
+  struct Variant {
+    double dt;
+  } fine{0.0}, coarse{0.0};
+  RunRecord fine_run, coarse_run;
+  {
+    Scene s = variant(refine);
+    fine.dt = s.dt;
+    fine_run = run_engine_isolated(std::move(s), *engine, ro);
+  }
+  {
+    Scene s = variant(refine / 2);
+    coarse.dt = s.dt;
+    coarse_run = run_engine_isolated(std::move(s), *engine, ro);
+  }
   ref.dt = fine.dt;
   if (fine_run.status != RunStatus::Ok || coarse_run.status != RunStatus::Ok) {
     const RunRecord& bad = fine_run.status != RunStatus::Ok ? fine_run : coarse_run;

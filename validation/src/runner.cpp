@@ -326,7 +326,11 @@ std::string seconds_text(double seconds) {
 
 }  // namespace
 
-RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, const RunOptions& options) {
+namespace {
+
+// `owned`: the caller's scene, released in the parent as soon as the child has its copy
+// (a large scene's copy need not live while the record comes back).
+RunRecord run_isolated(const Scene& scene, const EngineFactory& factory, const RunOptions& options, Scene* owned) {
   if (!options.isolate) return run_engine(scene, factory, options);
   int fds[2];
   if (::pipe(fds) != 0) return run_engine(scene, factory, options);
@@ -355,6 +359,9 @@ RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, 
   }
   remember_live_child(pid);
   ::close(fds[1]);
+  RunRecord fallback = blank_record(scene, factory.info);
+  fallback.status = RunStatus::Error;
+  if (owned != nullptr) *owned = Scene{};   // `scene` is not read again below
   // The record is read straight from the pipe into a RunRecord as it arrives.
   std::optional<std::chrono::steady_clock::time_point> deadline;
   if (options.timeout_seconds > 0.0) {
@@ -387,8 +394,6 @@ RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, 
   int wstatus = 0;
   while (::waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
   }
-  RunRecord fallback = blank_record(scene, factory.info);
-  fallback.status = RunStatus::Error;
   if (timed_out) {
     fallback.reason = "timed out after " + seconds_text(options.timeout_seconds) + " s";
     return fallback;
@@ -407,6 +412,16 @@ RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, 
     return fallback;
   }
   return std::move(*record);
+}
+
+}  // namespace
+
+RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, const RunOptions& options) {
+  return run_isolated(scene, factory, options, nullptr);
+}
+
+RunRecord run_engine_isolated(Scene&& scene, const EngineFactory& factory, const RunOptions& options) {
+  return run_isolated(scene, factory, options, &scene);
 }
 
 }  // namespace physval

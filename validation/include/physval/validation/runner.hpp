@@ -40,6 +40,9 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& engine, const RunO
 
 // The same in a child process (when options.isolate), surviving crashes and hangs.
 RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& engine, const RunOptions& options);
+// The same for a scene the caller gives away (a variant made for this run): the parent
+// releases it once the child has forked, before the record comes back.
+RunRecord run_engine_isolated(Scene&& scene, const EngineFactory& factory, const RunOptions& options);
 
 // A run that never happened because the engine cannot model the scene.
 RunRecord unsupported_run(const Scene& scene, const EngineInfo& info, const std::vector<std::string>& missing);
