@@ -213,6 +213,7 @@ class EventLoop {
   // Body i's path changed at time t: register its new path and find its next events.
   void reschedule(std::uint32_t i, double t) {
     if (!w_.alive(i)) return;
+    start_substep(w_, i, t, T_);
     // Others find i through its registered box (grown to cover the new path); i's own
     // new events can only be with bodies whose registered boxes meet its new path.
     const Aabb box = path_box(w_, i, t, T_);
@@ -233,6 +234,8 @@ class EventLoop {
       if (aj) reschedule(j, t);
       return;
     }
+    start_substep(w_, i, t, T_);
+    start_substep(w_, j, t, T_);
     const Aabb box_i = path_box(w_, i, t, T_), box_j = path_box(w_, j, t, T_);
     w_.bp->grow(i, box_i);
     w_.bp->grow(j, box_j);
@@ -289,20 +292,25 @@ class EventLoop {
     switch (e.kind()) {
       case EventKind::Pair: process_pair(e.a, e.b, e.time, t_abs); break;
       case EventKind::Static: process_static(e.a, e.b, e.feature(), e.time, t_abs); break;
-      case EventKind::Stop:
-        w_.advance(e.a, e.time);
+      case EventKind::Stop: {
+        // On the integrator's own path, which ends a sub-step (substeps.cpp).
+        const double t = refine_stop(w_, e.a, e.time, w_.tloc[e.a], T_);
+        end_substep(w_, e.a, t);
         w_.vel[e.a] = {};
         support_path(w_, e.a);
         ++w_.version[e.a];
-        reschedule(e.a, e.time);
+        reschedule(e.a, t);
         break;
-      case EventKind::Leave:
-        w_.advance(e.a, e.time);
+      }
+      case EventKind::Leave: {
+        const double t = refine_leave(w_, e.a, e.time, w_.tloc[e.a], T_);
+        end_substep(w_, e.a, t);
         release_support(w_, e.a);
         ++w_.version[e.a];
-        reschedule(e.a, e.time);
-        free_dependents(e.a, e.time);
+        reschedule(e.a, t);
+        free_dependents(e.a, t);
         break;
+      }
       case EventKind::Expire:
         w_.advance(e.a, e.time);
         kill_body(w_, e.a);
@@ -320,10 +328,17 @@ class EventLoop {
   }
 
   void process_pair(std::uint32_t i, std::uint32_t j, double t, double t_abs) {
-    w_.advance(i, t);
-    w_.advance(j, t);
-    ++w_.stats.impacts;
     const PairResponse& r = w_.response(w_.group[i], w_.group[j]);
+    if (r.collide) {   // on the integrator's own path, which ends a sub-step (substeps.cpp)
+      t = refine_pair_impact(w_, i, j, t, std::max(w_.tloc[i], w_.tloc[j]), T_);
+      t_abs = ctx_.t0 + t;
+      end_substep(w_, i, t);
+      end_substep(w_, j, t);
+    } else {
+      w_.advance(i, t);
+      w_.advance(j, t);
+    }
+    ++w_.stats.impacts;
     if (!r.collide) {   // "event": pass through, report once
       if (r.event) record_contact(w_, i, j, nullptr, t_abs, ctx_.dt);
       add_passing(w_, pair_key(i, j));
@@ -395,10 +410,16 @@ class EventLoop {
   }
 
   void process_static(std::uint32_t i, std::uint32_t k, std::uint8_t feature, double t, double t_abs) {
-    w_.advance(i, t);
-    ++w_.stats.impacts;
     const Segment& seg = w_.statics.segments[k];
     const PairResponse& r = w_.response(w_.group[i], seg.group);
+    if (r.collide) {   // on the integrator's own path, which ends a sub-step (substeps.cpp)
+      t = refine_static_impact(w_, i, seg, feature != 0, t, w_.tloc[i], T_);
+      t_abs = ctx_.t0 + t;
+      end_substep(w_, i, t);
+    } else {
+      w_.advance(i, t);
+    }
+    ++w_.stats.impacts;
     if (!r.collide) {
       if (r.event) record_contact(w_, i, kNone, &seg, t_abs, ctx_.dt);
       add_passing(w_, static_key(i, k));

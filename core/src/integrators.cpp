@@ -11,8 +11,13 @@
 //                         end correction dt/6 (k4 - k1) to reach RK4's velocity
 //
 // Without collisions each reproduces its textbook scheme exactly; an impact changes
-// the velocity at its time and the path continues from there. A body resting on a
-// support moves with its constrained acceleration whatever the integrator.
+// the velocity at its time and the path continues from there. With forces that depend
+// on the velocity, an impact under velocity Verlet or RK4 instead cuts the step into
+// sub-steps, each one step of the scheme (substeps.cpp), so the scheme keeps its order.
+// A body resting on a support moves with its constrained acceleration whatever the
+// integrator.
+#include <algorithm>
+
 #include "world.hpp"
 
 namespace physval::core_detail {
@@ -71,6 +76,13 @@ void begin_paths(World& w, const StepContext& ctx) {
   if (!w.any_forces) return;   // every path is a straight line
   const std::size_t n = w.size();
   const double dt = ctx.dt;
+  if (w.varying_forces) {
+    // Each body's first sub-step is the whole step (substeps.cpp: impacts cut it).
+    std::fill(w.tsub.begin(), w.tsub.end(), 0.0);
+    std::copy(w.pos.begin(), w.pos.end(), w.psub.begin());
+    std::copy(w.vel.begin(), w.vel.end(), w.vsub.begin());
+    std::copy(w.acc.begin(), w.acc.end(), w.ksub.begin());
+  }
   switch (w.integrator) {
     case Integrator::ExplicitEuler:
       for (std::uint32_t i = 0; i < n; ++i) {
@@ -99,6 +111,10 @@ void begin_paths(World& w, const StepContext& ctx) {
       }
       break;
   }
+  // A body sliding on a face under drag: its support's law integrated by the scheme too.
+  for (std::uint32_t i = 0; w.varying_forces && i < n; ++i) {
+    if (w.supported(i) && uses_substeps(w, i)) start_substep(w, i, 0.0, dt);
+  }
 }
 
 void end_paths(World& w, const StepContext& ctx) {
@@ -122,14 +138,19 @@ void end_paths(World& w, const StepContext& ctx) {
           a1.resize(n);
           compute_accelerations(w, w.pos, w.vel, a1);
           for (std::uint32_t i = 0; i < n; ++i) {
-            if (free_dynamic(w, i)) w.vel[i] += (0.5 * T) * (a1[i] - w.apath[i]);
+            // Over the body's last sub-step (the whole step unless an impact cut it).
+            if (free_dynamic(w, i)) {
+              w.vel[i] += (0.5 * (T - w.tsub[i])) * (a1[i] - w.apath[i]);
+            } else if (uses_substeps(w, i)) {   // sliding on a face
+              w.vel[i] += (0.5 * (T - w.tsub[i])) * (substep_acceleration(w, i, w.vel[i]) - w.apath[i]);
+            }
           }
         }
         break;
       case Integrator::Rk4:
         if (w.varying_forces) {
           for (std::uint32_t i = 0; i < n; ++i) {
-            if (free_dynamic(w, i)) w.vel[i] += w.vcorr[i];
+            if (free_dynamic(w, i) || uses_substeps(w, i)) w.vel[i] += w.vcorr[i];
           }
         }
         break;

@@ -48,13 +48,16 @@ void support_path(World& w, std::uint32_t i) {
     w.apath[i] = {};
     return;
   }
+  const double vt = dot(w.vel[i], perp(w.support_n[i]));
+  w.vel[i] = vt * perp(w.support_n[i]);   // no normal velocity on a support
+  w.apath[i] = support_acceleration(w, i, w.acc[i], vt);
+}
+
+Vec2 support_acceleration(const World& w, std::uint32_t i, Vec2 a, double vt) {
   const Segment& s = w.statics.segments[w.support[i]];
   const Vec2 n = w.support_n[i];
   const Vec2 t = perp(n);
-  const Vec2 a = w.acc[i];
   const double normal_per_mass = -dot(a, n);   // N / m
-  const double vt = dot(w.vel[i], t);
-  w.vel[i] = vt * t;   // no normal velocity on a support
   const double at = dot(a, t);
   const Coefficients c = coefficients(w, i, s);
   const double limit_moving = c.moving * std::max(normal_per_mass, 0.0);
@@ -65,7 +68,7 @@ void support_path(World& w, std::uint32_t i) {
   } else {
     a_t = at - std::copysign(limit_moving, vt);
   }
-  w.apath[i] = a_t * t;
+  return a_t * t;
 }
 
 void release_support(World& w, std::uint32_t i) {

@@ -150,6 +150,11 @@ struct World {
   std::vector<Vec2> acc;             // any_forces: force / mass at the step start
   std::vector<Vec2> apath;           // any_forces: the path's acceleration this step
   std::vector<Vec2> vcorr;           // varying_forces: end-of-step velocity correction
+  // varying_forces: each body's current sub-step. A step is one sub-step unless an
+  // impact (or a lift-off) changes the body's velocity inside it; the integrator then
+  // starts a new sub-step there (substeps.cpp). Its start time, state and acceleration:
+  std::vector<double> tsub;
+  std::vector<Vec2> psub, vsub, ksub;
   std::vector<ForceParams> fparams;  // drag or thrust only
   std::vector<ThrustDef> thrusts;
   std::vector<std::uint32_t> support;   // any_forces: segment (or kBodySupport | body) a body rests on, or kNone
@@ -250,7 +255,13 @@ struct World {
       dep_head.push_back(kNone);
       dep_next.push_back(kNone);
     }
-    if (varying_forces) vcorr.push_back({});
+    if (varying_forces) {
+      vcorr.push_back({});
+      tsub.push_back(0.0);
+      psub.push_back({});
+      vsub.push_back({});
+      ksub.push_back({});
+    }
   }
   // The rest speed for a contact pressed together with normal acceleration a_n.
   double rest_speed(double a_n, double dt) const {
@@ -266,6 +277,9 @@ std::vector<OptionSpec> core_option_specs();
 // ---- stages of the step, in pipeline order
 void compute_accelerations(World& w, std::span<const Vec2> pos, std::span<const Vec2> vel,
                            std::span<Vec2> out);                 // accelerations.cpp
+// One body's acceleration from its own forces (field, drag, thrust; not Newtonian
+// gravity, which needs every body) at velocity vel (accelerations.cpp).
+Vec2 body_acceleration(const World& w, std::uint32_t i, Vec2 vel);
 void apply_supports(World& w, const StepContext& ctx);          // resting_contact.cpp
 void begin_paths(World& w, const StepContext& ctx);             // integrators.cpp
 void collide_exact(World& w, StepContext& ctx);                 // exact_collisions.cpp
@@ -284,6 +298,10 @@ void record_emission(World& w, std::uint32_t emitter, Vec2 position, Vec2 veloci
 // Path acceleration of a supported body: the normal component removed and Coulomb
 // friction (or rolling resistance) along the support (resting_contact.cpp).
 void support_path(World& w, std::uint32_t i);
+// The support's law for body i on its segment: the acceleration along the face under
+// the force acceleration a (its normal part taken by the support), with kinetic
+// friction against the sign of vt, or at vt == 0 held by static friction up to its limit.
+Vec2 support_acceleration(const World& w, std::uint32_t i, Vec2 a, double vt);
 // Releases body i from its support.
 void release_support(World& w, std::uint32_t i);
 // Body i comes to rest on body j (stuck there), along n from j to i.
@@ -297,6 +315,37 @@ void collect_dependents(World& w, std::uint32_t j);
 // segment, from time t (toi::kNever if not in [t, T]).
 double support_stop_time(const World& w, std::uint32_t i, double t, double T);
 double support_leave_time(const World& w, std::uint32_t i, double t, double T);
+
+// Sub-steps (substeps.cpp): an impact inside a step keeps the integrator's order.
+// Whether body i follows sub-steps of its integrator, so that a velocity change inside
+// a step starts a new one: state-dependent forces, velocity Verlet or RK4, no Newtonian
+// gravity, free or sliding on a face (not at rest on bodies).
+bool uses_substeps(const World& w, std::uint32_t i);
+// The acceleration of body i on sub-steps at velocity v: its forces', or on a face the
+// support's law with friction against the sliding direction of the sub-step's start.
+Vec2 substep_acceleration(const World& w, std::uint32_t i, Vec2 v);
+// Body i's state at time t of the step as its integrator gives it: one step of the
+// integrator from the start of its current sub-step to t. Off sub-steps: its path.
+struct PathState {
+  Vec2 p, v;
+};
+PathState integrator_state(const World& w, std::uint32_t i, double t);
+// Whether an impact of body i needs its time found on the integrator's own path
+// (RK4: its path through the sub-step's end differs from the step cut at the impact).
+bool needs_impact_refinement(const World& w, std::uint32_t i);
+// Moves body i to its integrator state at t (the sub-step ends there).
+void end_substep(World& w, std::uint32_t i, double t);
+// Body i's velocity changed at t (T: the step's length): a new sub-step from its state at t.
+void start_substep(World& w, std::uint32_t i, double t, double T);
+// The time of an impact found at t on the paths, moved to the root of the gap on the
+// integrator's own path (within [t_min, T]); t itself when nothing needs refining.
+double refine_static_impact(const World& w, std::uint32_t i, const Segment& seg, bool cap, double t, double t_min,
+                            double T);
+double refine_pair_impact(const World& w, std::uint32_t i, std::uint32_t j, double t, double t_min, double T);
+// The same for a sliding body's stop (its velocity along the face reaches 0) and for
+// its leaving the end of its segment.
+double refine_stop(const World& w, std::uint32_t i, double t, double t_min, double T);
+double refine_leave(const World& w, std::uint32_t i, double t, double t_min, double T);
 
 // Box bounding body i's path from t to T (swept), plus its radius.
 Aabb path_box(const World& w, std::uint32_t i, double t, double T);

@@ -199,7 +199,7 @@ void load_world(World& w, const Scene& scene) {
   if (any_thrust) w.angle.reserve(cap);
   if (any_drag || any_thrust) w.fparams.reserve(cap);
   if (w.any_forces) reserve_all(w.acc, w.apath, w.support, w.support_n, w.dep_head, w.dep_next);
-  if (w.varying_forces) w.vcorr.reserve(cap);
+  if (w.varying_forces) reserve_all(w.vcorr, w.tsub, w.psub, w.vsub, w.ksub);
 
   double extent = 0.0;
   double max_radius = 0.0;
@@ -324,7 +324,7 @@ std::size_t World::memory_bytes() const {
   std::size_t n = sizeof(World);
   n += bytes_of(pos) + bytes_of(vel) + bytes_of(tloc) + bytes_of(inv_mass) + bytes_of(radius) + bytes_of(version);
   n += bytes_of(flags) + bytes_of(group) + bytes_of(material) + bytes_of(mass) + bytes_of(angle);
-  n += bytes_of(acc) + bytes_of(apath) + bytes_of(vcorr) + bytes_of(fparams) + bytes_of(support);
+  n += bytes_of(acc) + bytes_of(apath) + bytes_of(vcorr) + bytes_of(tsub) + bytes_of(psub) + bytes_of(vsub) + bytes_of(ksub) + bytes_of(fparams) + bytes_of(support);
   n += bytes_of(dep_head) + bytes_of(dep_next) + bytes_of(released);
   n += bytes_of(support_n) + last_touch.size() * (sizeof(std::uint64_t) + sizeof(double) + 2 * sizeof(void*)) + bytes_of(name_end);
   n += name_chars.capacity() + 1;

@@ -14,6 +14,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "physval/adapters/plugin_engine.hpp"
 #include "physval/adapters/registry.hpp"
 #include "physval/validation/console_table.hpp"
 #include "physval/validation/gate.hpp"
@@ -73,7 +74,16 @@ struct CommonOptions {
   std::string cache;
   bool no_cache = false;
   std::string shard;   // "I/N"
+  std::vector<std::string> plugins;
 };
+
+// --plugin LIB.so (repeatable): an engine plugin, a path or a name searched in PHYSVAL_PLUGIN_PATH.
+void add_plugin_option(CLI::App* cmd, std::vector<std::string>& plugins) {
+  cmd->add_option("--plugin", plugins,
+                  "load an engine plugin (a shared library, see physval/plugin.h): a path, or a name searched "
+                  "in PHYSVAL_PLUGIN_PATH; repeatable")
+      ->allow_extra_args(false);
+}
 
 void add_common(CLI::App* cmd, CommonOptions& o) {
   cmd->add_option("PATH", o.paths, "scenario files (*.toml) or folders of them (searched recursively)")->required();
@@ -89,6 +99,7 @@ void add_common(CLI::App* cmd, CommonOptions& o) {
   cmd->add_flag("--quiet", o.quiet, "print only the summary line");
   cmd->add_option("--cache", o.cache, "reference cache folder (default $XDG_CACHE_HOME/physval/references or ~/.cache/...)");
   cmd->add_flag("--no-cache", o.no_cache, "compute every reference, read and write no cache");
+  add_plugin_option(cmd, o.plugins);
   cmd->add_option("-j,--jobs", o.jobs, "references and engine runs at once (default 0: every core); results do not depend on it");
   cmd->add_option("--shard", o.shard,
                   "run only part I of N (0 <= I < N) of the scenarios, split by estimated cost; "
@@ -230,6 +241,7 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
     }
     nlohmann::json run_options = {
         {"engines", o.engines},
+        {"plugins", o.plugins},
         {"dt", options.dt ? nlohmann::json(*options.dt) : nlohmann::json(nullptr)},
         {"duration", options.duration ? nlohmann::json(*options.duration) : nlohmann::json(nullptr)},
         {"timeout", o.timeout},
@@ -411,6 +423,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> check_paths;
   auto* check = app.add_subcommand("check", "parse and validate scenario files; runs nothing");
   check->add_option("PATH", check_paths, "scenario files or folders")->required();
+  std::vector<std::string> check_plugins;
+  add_plugin_option(check, check_plugins);
 
   std::string sweep_scenario, sweep_out = "physval-sweep", sweep_duration;
   std::vector<std::string> sweep_dts, sweep_engines;
@@ -429,6 +443,8 @@ int main(int argc, char** argv) {
   sweep->add_option("--duration", sweep_duration, "override the scenario's duration, seconds");
   sweep->add_flag("--no-settings", sweep_no_settings, "sweep step sizes only, each engine at its default settings");
   sweep->add_flag("--quiet", sweep_quiet, "no progress on the terminal");
+  std::vector<std::string> sweep_plugins;
+  add_plugin_option(sweep, sweep_plugins);
   double sweep_timeout = 0.0;
   std::string sweep_cache;
   bool sweep_no_cache = false;
@@ -456,12 +472,27 @@ int main(int argc, char** argv) {
   bool engines_json = false;
   auto* engines = app.add_subcommand("engines", "each engine, its version, precision, options and what it can model");
   engines->add_flag("--json", engines_json, "print as JSON");
+  std::vector<std::string> engines_plugins;
+  add_plugin_option(engines, engines_plugins);
 
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return code == 0 ? 0 : kExitBadInput;
+  }
+
+  // Plugins join the registry before any scenario is read: their option tables and
+  // [gate.<plugin>] tables are then validated like a built-in engine's.
+  try {
+    const std::vector<std::string>& plugins = *check     ? check_plugins
+                                              : *sweep   ? sweep_plugins
+                                              : *engines ? engines_plugins
+                                              : *gate    ? gate_opts.plugins
+                                                         : run_opts.plugins;
+    register_plugins(plugins);
+  } catch (const std::exception& e) {
+    return bad_input(std::string(e.what()) + "; nothing was run");
   }
 
   try {
@@ -552,6 +583,7 @@ int main(int argc, char** argv) {
         result.shard["scenario"] = {{"name", load.scene->name}, {"file", file_fingerprint(sweep_scenario)}};
         result.shard["options"] = {{"dt", so.dts},
                                    {"engines", so.engines},
+                                   {"plugins", sweep_plugins},
                                    {"repetitions", so.repetitions},
                                    {"settings", so.settings},
                                    {"duration", load.scene->duration},

@@ -406,8 +406,8 @@ void compare_run(RunRecord& run, const Scene& scene, const Reference& reference,
   const Series& s = run.series;
   if (!s.totals.empty()) {
     const Totals& t0 = s.totals.front();
-    double de = 0.0, dp = 0.0, dl = 0.0;
-    std::optional<double> runaway_at;
+    double de = 0.0, dp = 0.0, dl = 0.0, gain = 0.0;
+    std::optional<double> runaway_at, gain_at;
     for (std::size_t k = 0; k < s.totals.size(); ++k) {
       const double e = std::abs(s.totals[k].energy() - t0.energy()) / scales.energy;
       if (std::isnan(e)) continue;
@@ -415,7 +415,11 @@ void compare_run(RunRecord& run, const Scene& scene, const Reference& reference,
       dp = std::max(dp, length(s.totals[k].momentum - t0.momentum) / scales.momentum);
       dl = std::max(dl, std::abs(s.totals[k].angular_momentum - t0.angular_momentum) / scales.angular_momentum);
       if (conserved.energy && e > 1.0 && !runaway_at) runaway_at = s.time[k];
+      const double g = (s.totals[k].energy() - t0.energy()) / scales.energy;
+      gain = std::max(gain, g);
+      if (conserved.energy_non_increasing && !conserved.energy && g > 1.0 && !gain_at) gain_at = s.time[k];
     }
+    if (conserved.energy_non_increasing && !conserved.energy) run.metrics["energy_gain"] = gain;
     if (conserved.energy) run.metrics["energy_drift"] = de;
     if (conserved.linear_momentum) run.metrics["linear_momentum_drift"] = dp;
     if (conserved.angular_momentum) run.metrics["angular_momentum_drift"] = dl;
@@ -423,6 +427,15 @@ void compare_run(RunRecord& run, const Scene& scene, const Reference& reference,
       run.status = RunStatus::Diverged;
       run.diverged_at = runaway_at;
       run.reason = "energy ran away: it changed by " + fmt(de) + " x the scene's energy scale";
+    }
+    // A blow-up in a scene that can only lose energy (friction, drag, e < 1) is found
+    // without a reference: a reference of a chaotic pile does not converge, and an engine
+    // whose bodies fly apart must still not be ok.
+    if (gain_at && run.status == RunStatus::Ok) {
+      run.status = RunStatus::Diverged;
+      run.diverged_at = gain_at;
+      run.reason = "energy grew by " + fmt(gain) + " x the scene's energy scale in a scene that can only lose it "
+                   "(no thrust, wind or emitter): a blow-up";
     }
   }
 
@@ -438,6 +451,22 @@ void compare_run(RunRecord& run, const Scene& scene, const Reference& reference,
       run.reason = std::to_string(*c.escaped_bodies) + " of " + std::to_string(scene.bodies.size()) +
                    " bodies escaped the region the walls enclose (first at t = " + fmt(c.first_escape_time.value_or(0.0)) +
                    " s)";
+    }
+  }
+
+  // core in exact mode guarantees that nothing overlaps (impacts at their exact times,
+  // resting contacts held on their constraints): an overlap beyond round-off means the
+  // guarantee broke, and the reference engine must not be ok on that run.
+  if (run.engine == "core" && run.status == RunStatus::Ok) {
+    const bool exact = std::any_of(run.settings.begin(), run.settings.end(), [](const Setting& st) {
+      return st.first == "collision" && st.second == "exact";
+    });
+    const auto pen = run.metrics["max_penetration"];
+    const double allowed = 1e-9 + 1e-12 * scales.length;
+    if (exact && pen && *pen > allowed) {
+      run.status = RunStatus::Diverged;
+      run.reason = "core's exact contacts left an overlap of " + fmt(*pen) + " m (more than round-off, " +
+                   fmt(allowed) + " m): its no-overlap guarantee broke";
     }
   }
 

@@ -67,6 +67,29 @@ Conserved conserved_quantities(const Scene& scene) {
            r.response == CollisionResponse::DestroyBoth;
   });
 
+  // Friction between two moving bodies: its tangential impulse acts at the contact point,
+  // but bodies do not spin (the lecture model, and every adapter's default fixed_rotation),
+  // so the torque it exerts about each centre goes into no spin: orbital angular momentum
+  // changes by (x_a - x_b) x J. A pair has friction when both bodies have a coefficient
+  // (the rule is the geometric mean) or a [[materials]] override between bodies gives one.
+  auto has_friction = [](const BodyDef& b) {
+    return b.friction > 0.0 || b.static_friction > 0.0 || b.rolling_friction > 0.0;
+  };
+  const auto moving_with_friction = std::count_if(scene.bodies.begin(), scene.bodies.end(), [&](const BodyDef& b) {
+    return !b.is_static && has_friction(b);
+  });
+  auto is_moving_body = [&](const std::string& name) {
+    return std::any_of(scene.bodies.begin(), scene.bodies.end(),
+                       [&](const BodyDef& b) { return b.name == name && !b.is_static; });
+  };
+  const bool pair_friction =
+      moving_with_friction >= 2 ||
+      std::any_of(scene.materials.begin(), scene.materials.end(), [&](const MaterialOverride& m) {
+        return (m.friction.value_or(0.0) > 0.0 || m.static_friction.value_or(0.0) > 0.0 ||
+                m.rolling_friction.value_or(0.0) > 0.0) &&
+               is_moving_body(m.a) && is_moving_body(m.b);
+      });
+
   if (has_barriers) c.momentum_why = "barriers or static bodies push";
   else if (field) c.momentum_why = "a uniform field pulls";
   else if (drag) c.momentum_why = "drag";
@@ -77,7 +100,7 @@ Conserved conserved_quantities(const Scene& scene) {
   c.linear_momentum = c.momentum_why == "no external force";
   // Contact impulses act along the line through both centres at the contact point,
   // and friction impulses at that same point: about the origin they cancel too.
-  c.angular_momentum = c.linear_momentum;
+  c.angular_momentum = c.linear_momentum && !pair_friction;
 
   if (friction) c.energy_why = "friction";
   else if (drag) c.energy_why = "drag";
@@ -87,6 +110,11 @@ Conserved conserved_quantities(const Scene& scene) {
   else if (destroys) c.energy_why = "the collision matrix destroys bodies";
   else c.energy_why = "elastic, frictionless, no drag or thrust";
   c.energy = c.energy_why == "elastic, frictionless, no drag or thrust";
+
+  const bool wind = scene.world.wind.x != 0.0 || scene.world.wind.y != 0.0;
+  // A destroyed body takes its potential energy along, which can be negative (below the
+  // field's zero, or bound in a Newtonian well): destroys are left out too.
+  c.energy_non_increasing = !thrust && !particles && !(drag && wind) && !destroys;
 
   if (scene.conserves.energy) {
     c.energy = *scene.conserves.energy;

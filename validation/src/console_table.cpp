@@ -1,5 +1,6 @@
 #include "physval/validation/console_table.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 
@@ -71,7 +72,10 @@ void print_suite_table(std::ostream& os, const SuiteResult& result) {
     else if (ref.converged) os << "core dt " << num(ref.dt, "%.3g") << ", converged to " << num(ref.convergence_error) << " m";
     else os << ref.reason;
     os << ")\n";
-    os << "  " << pad("engine", 7) << pad("status", 12) << rpad("E drift", 8) << rpad("P drift", 8) << rpad("pos div", 9)
+    // The engine column fits the longest name (a plugin's may exceed the built-ins' 6).
+    std::size_t engine_w = 7;
+    for (const RunRecord& r : sr.runs) engine_w = std::max(engine_w, r.engine.size() + 1);
+    os << "  " << pad("engine", engine_w) << pad("status", 12) << rpad("E drift", 8) << rpad("P drift", 8) << rpad("pos div", 9)
        << rpad("E div", 8) << rpad("contact", 11) << rpad("steps", 6) << rpad("miss", 6) << rpad("extra", 6)
        << rpad("wall ms", 9) << rpad("checks", 7) << '\n';
     for (const RunRecord& r : sr.runs) {
@@ -91,7 +95,7 @@ void print_suite_table(std::ostream& os, const SuiteResult& result) {
       }
       std::string contact = metric(r, "contact_time_error");
       if (contact != "-") contact += " s";
-      os << "  " << pad(r.engine, 7) << pad(run_status_name(r.status), 12) << rpad(metric(r, "energy_drift"), 8)
+      os << "  " << pad(r.engine, engine_w) << pad(run_status_name(r.status), 12) << rpad(metric(r, "energy_drift"), 8)
          << rpad(metric(r, "linear_momentum_drift"), 8) << rpad(metric(r, "position_divergence"), 9)
          << rpad(metric(r, "energy_divergence"), 8) << rpad(contact, 11)
          << rpad(metric(r, "contact_time_error_steps", "%.2f"), 6) << rpad(count(r, "missed_contacts"), 6)
@@ -116,13 +120,13 @@ void print_suite_table(std::ostream& os, const SuiteResult& result) {
                      " within the bounds recorded in [gate." + r.engine + "] known_failures:");
         for (const Check& c : r.checks) {
           if (!(c.known_failure && c.pass)) continue;
-          note(os, "- " + c.what + ": " + off(c) + (c.value ? ", bound " + num(c.limit, "%.3g") : std::string("")) + ")");
+          note(os, "- " + c.what + ": " + off(c) + (c.value ? (c.detail.empty() ? "bound " : ", bound ") + num(c.limit, "%.3g") : std::string("")) + ")");
         }
       }
       for (const Check& c : r.checks) {
         if (c.pass) continue;
         const std::string limit = c.known_failure ? "bound " : c.what.rfind("expect.", 0) == 0 ? "tolerance " : "limit ";
-        const std::string sep = c.detail.empty() && !c.value ? "" : ", ";
+        const std::string sep = c.detail.empty() ? "" : ", ";
         if (c.enforced) {
           note(os, r.engine + " FAILED " + c.what + ": " + off(c) + sep + limit + num(c.limit, "%.3g") + ")");
         } else {

@@ -169,6 +169,59 @@ TEST(Comparator, EnergyRunawayIsDiverged) {
   EXPECT_NEAR(*r.metrics["energy_drift"], 3.0, 1e-9);
 }
 
+// A scene that can only lose energy (friction, e < 1) and whose reference cannot judge it
+// (none here, as for a chaotic pile): before energy_gain, an engine blowing up was ok.
+TEST(Comparator, EnergyGainInASceneThatCanOnlyLoseEnergyIsDiverged) {
+  Scene s = two_bodies();
+  s.bodies[0].restitution = 0.5;
+  s.bodies[1].friction = 0.3;
+  RunRecord r = run_engine(s, fake(Fault::GainEnergy), RunOptions{});
+  compare_run(r, s, Reference{}, false);
+  EXPECT_FALSE(r.metrics["energy_drift"]) << "energy is not conserved here";
+  ASSERT_TRUE(r.metrics["energy_gain"]);
+  EXPECT_NEAR(*r.metrics["energy_gain"], 3.0, 1e-9);
+  EXPECT_EQ(r.status, RunStatus::Diverged);
+  EXPECT_NE(r.reason.find("can only lose"), std::string::npos) << r.reason;
+
+  RunRecord honest = run_engine(s, fake(Fault::None), RunOptions{});
+  compare_run(honest, s, Reference{}, false);
+  EXPECT_EQ(honest.status, RunStatus::Ok);
+  ASSERT_TRUE(honest.metrics["energy_gain"]);
+  EXPECT_EQ(*honest.metrics["energy_gain"], 0.0);
+
+  // Thrust or wind can add energy: no bound is claimed, the metric is null.
+  s.world.wind = {1.0, 0.0};
+  s.bodies[0].drag_linear = 0.1;
+  RunRecord windy = run_engine(s, fake(Fault::GainEnergy), RunOptions{});
+  compare_run(windy, s, Reference{}, false);
+  EXPECT_FALSE(windy.metrics["energy_gain"]);
+  EXPECT_EQ(windy.status, RunStatus::Ok);
+}
+
+// core in exact mode guarantees no overlap; before this rule a core run whose pile
+// collapsed into 6 cm overlaps was ok (and is the engine the others are measured against).
+TEST(Comparator, ReferenceEngineOverlapBeyondRoundOffIsDiverged) {
+  const Scene s = two_bodies();   // the fake passes the two discs through each other
+  RunRecord r = run_engine(s, fake(Fault::None), RunOptions{});
+  r.engine = "core";
+  r.settings = {{"collision", "exact"}};
+  compare_run(r, s, Reference{}, false);
+  ASSERT_TRUE(r.metrics["max_penetration"]);
+  EXPECT_GT(*r.metrics["max_penetration"], 0.5);
+  EXPECT_EQ(r.status, RunStatus::Diverged);
+  EXPECT_NE(r.reason.find("no-overlap guarantee"), std::string::npos) << r.reason;
+
+  // The lecture's one-pass scheme makes no such promise; another engine is held by its gates.
+  RunRecord lecture = run_engine(s, fake(Fault::None), RunOptions{});
+  lecture.engine = "core";
+  lecture.settings = {{"collision", "lecture"}};
+  compare_run(lecture, s, Reference{}, false);
+  EXPECT_EQ(lecture.status, RunStatus::Ok);
+  RunRecord other = run_engine(s, fake(Fault::None), RunOptions{});
+  compare_run(other, s, Reference{}, false);
+  EXPECT_EQ(other.status, RunStatus::Ok);
+}
+
 TEST(Comparator, DriftIsNullWhereNotConservedAndZeroForExactFlight) {
   Scene s = two_bodies();
   RunRecord r = run_engine(s, fake(Fault::None), RunOptions{});

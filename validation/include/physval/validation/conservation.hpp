@@ -19,6 +19,11 @@ struct Conserved {
   bool energy = false;
   bool linear_momentum = false;
   bool angular_momentum = false;
+  // Energy can only be lost: no thrust, no wind, no emitter (an explosion gives its
+  // particles energy), no destroy rule (a destroyed body takes away its potential energy,
+  // which may be negative). Friction, drag towards still air and restitution below 1 only
+  // take energy away, so E(t) <= E(0) for a correct engine.
+  bool energy_non_increasing = false;
   std::string energy_why;     // the rule that decided, for the README and reports
   std::string momentum_why;
 };

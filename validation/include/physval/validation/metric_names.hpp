@@ -7,7 +7,7 @@
 
 namespace physval {
 
-inline constexpr std::array<std::string_view, 18> kMetricNames = {
+inline constexpr std::array<std::string_view, 19> kMetricNames = {
     "energy_drift",
     "linear_momentum_drift",
     "angular_momentum_drift",
@@ -26,6 +26,7 @@ inline constexpr std::array<std::string_view, 18> kMetricNames = {
     "expectation_failures",
     "max_penetration",
     "escaped_bodies",
+    "energy_gain",
 };
 
 inline bool is_metric_name(std::string_view name) {

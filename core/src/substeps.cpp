@@ -1,0 +1,253 @@
+// Sub-steps: an impact inside a step keeps the integrator's order when forces depend
+// on the velocity (drag, wind, thrust).
+//
+// Within a step every body follows the integrator's path model (integrators.cpp): a
+// parabola through the step's end position, and an end-of-step velocity correction.
+// For constant forces that path is exact and an impact may simply change the velocity
+// on it. With drag it is not: the parabola's acceleration and the correction were
+// computed from the velocity before the impact, so the rest of the step would be
+// integrated with the drag of the wrong velocity (first order, whatever the scheme),
+// and RK4's parabola meets the state RK4 gives at the impact time only to O(h^3).
+//
+// So an impact ends the body's sub-step and starts a new one, exactly as if the step
+// had been cut at the impact:
+//   1. the impact's time is the root of the gap along the integrator's own path,
+//      Phi(t) = one step of the integrator from the sub-step's start (t_s, x_s, v_s)
+//      with step t - t_s (RK4: Phi differs from the parabola by O(h^3), so the time
+//      found on the parabola is refined by a bracketed secant on Phi; velocity Verlet's
+//      position is the parabola itself);
+//   2. the body is put at Phi(t), position and velocity (RK4's four stages, or
+//      Verlet's end correction, for the step t - t_s);
+//   3. the impulse is applied;
+//   4. a new sub-step of length T - t starts from the new state: its path and end
+//      correction are the integrator's for that step.
+// A body sliding on a face follows the same rule with the support's law in the
+// stages (friction against the sliding direction of the sub-step's start, so the law
+// is smooth on it); its stop and its leaving the face's end are found on Phi too.
+// Every piece is then one step of the integrator between events, so the error after
+// any number of impacts shrinks at the integrator's order. The cost: per impact of a
+// body with such forces, 4 acceleration evaluations for the new sub-step, and for
+// RK4 2 per gap evaluation of the refinement (typically 4 of them).
+// Explicit and semi-implicit Euler are first order with or without an impact inside
+// a step and keep their lecture paths. Newtonian gravity couples every body's path, so
+// its scenes keep one sub-step per step (an impact there costs RK4 its order).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "world.hpp"
+
+namespace physval::core_detail {
+
+namespace {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+// A gap (or a velocity) within this many ulps of its scale is zero: the round-off of
+// evaluating it on the path, far below anything the scheme resolves.
+constexpr double kTolUlps = 4.0;
+
+double inf_norm(Vec2 v) { return std::max(std::fabs(v.x), std::fabs(v.y)); }
+
+bool on_face(const World& w, std::uint32_t i) { return w.supported(i) && !w.on_body(i); }
+
+// RK4 from (x_s, v_s) with k1 over step h; forces depend on the velocity only (no
+// Newtonian gravity on sub-steps). With want_velocity false k4 is skipped.
+PathState rk4_state(const World& w, std::uint32_t i, double h, bool want_velocity) {
+  const Vec2 x = w.psub[i], v = w.vsub[i], k1 = w.ksub[i];
+  const Vec2 k2 = substep_acceleration(w, i, v + (0.5 * h) * k1);
+  const Vec2 k3 = substep_acceleration(w, i, v + (0.5 * h) * k2);
+  PathState s;
+  s.p = x + h * v + (h * h / 6.0) * (k1 + k2 + k3);
+  if (want_velocity) {
+    const Vec2 k4 = substep_acceleration(w, i, v + h * k3);
+    s.v = v + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+  }
+  return s;
+}
+
+Vec2 position_on_path(const World& w, std::uint32_t i, double t) {
+  if (needs_impact_refinement(w, i)) return rk4_state(w, i, t - w.tsub[i], false).p;
+  return w.pos_at(i, t);
+}
+
+// A root of f near t0 in [lo, hi]: searched outward from t0 (later if f(t0) > 0, else
+// earlier) with growing strides, then closed by a bracketed secant (Illinois) with
+// bisection when it crawls. Returns a point where |f| <= ftol (f's round-off), else
+// the bracket's end with f <= 0 (contact reached); t0 when no sign change is found (a
+// graze the two paths see differently).
+template <class F>
+double root_near(F&& f, double t0, double lo, double hi, double ftol) {
+  const double f0 = f(t0);
+  if (std::fabs(f0) <= ftol || !(hi > lo)) return t0;
+  const double dir = f0 > 0.0 ? 1.0 : -1.0;
+  const double limit = dir > 0.0 ? hi : lo;
+  double stride = std::max(std::ldexp(hi - lo, -34), 4.0 * kEps * std::max(std::fabs(t0), hi - lo));
+  double a = t0, fa = f0, b = t0, fb = f0;
+  for (int k = 0; k < 64; ++k) {
+    double tn = t0 + dir * stride;
+    if (dir > 0.0 ? tn >= limit : tn <= limit) tn = limit;
+    const double fn = f(tn);
+    if ((fn > 0.0) != (f0 > 0.0)) {
+      b = tn;
+      fb = fn;
+      break;
+    }
+    if (tn == limit) return t0;
+    // The next stride at least doubles, and reaches past where the secant through the
+    // last two samples puts the root (usually bracketing it at the next sample).
+    double next = 2.0 * stride;
+    if (fn != fa) {
+      const double dist = dir * (tn - fn * (tn - a) / (fn - fa) - t0);
+      if (std::isfinite(dist)) next = std::max(next, 1.25 * dist);
+    }
+    a = tn;
+    fa = fn;
+    stride = next;
+  }
+  if ((fb > 0.0) == (f0 > 0.0)) return t0;
+  // Orient: p on the f > 0 side, q on the f <= 0 side.
+  double p = a, fp = fa, q = b, fq = fb;
+  if (fp <= 0.0) {
+    std::swap(p, q);
+    std::swap(fp, fq);
+  }
+  int side = 0;
+  for (int it = 0; it < 200; ++it) {
+    if (std::fabs(q - p) <= 4.0 * kEps * std::max(std::fabs(p), std::fabs(q)) || fq == 0.0) break;
+    double s = (fp * q - fq * p) / (fp - fq);
+    const double mid = 0.5 * (p + q);
+    if (!(std::min(p, q) < s && s < std::max(p, q))) s = mid;
+    if (it % 8 == 7) s = mid;   // a guaranteed halving now and then
+    const double fs = f(s);
+    if (std::fabs(fs) <= ftol) return s;
+    if (fs > 0.0) {
+      p = s;
+      fp = fs;
+      if (side == 1) fq *= 0.5;   // Illinois: the stale end's weight halves
+      side = 1;
+    } else {
+      q = s;
+      fq = fs;
+      if (side == -1) fp *= 0.5;
+      side = -1;
+    }
+  }
+  return q;
+}
+
+}  // namespace
+
+bool uses_substeps(const World& w, std::uint32_t i) {
+  return w.varying_forces && !w.newtonian && w.dynamic(i) && (!w.supported(i) || on_face(w, i)) &&
+         (w.integrator == Integrator::VelocityVerlet || w.integrator == Integrator::Rk4);
+}
+
+Vec2 substep_acceleration(const World& w, std::uint32_t i, Vec2 v) {
+  const Vec2 a = body_acceleration(w, i, v);
+  if (!w.supported(i)) return a;
+  // Friction keeps the direction it had at the sub-step's start: a body does not turn
+  // back without a stop event, so the law is smooth on every sub-step.
+  return support_acceleration(w, i, a, dot(w.vsub[i], perp(w.support_n[i])));
+}
+
+bool needs_impact_refinement(const World& w, std::uint32_t i) {
+  return w.integrator == Integrator::Rk4 && uses_substeps(w, i);
+}
+
+PathState integrator_state(const World& w, std::uint32_t i, double t) {
+  if (!uses_substeps(w, i)) return {w.pos_at(i, t), w.vel_at(i, t)};
+  const double h = t - w.tsub[i];
+  if (w.integrator == Integrator::Rk4) return rk4_state(w, i, h, true);
+  // Velocity Verlet: the parabola with a(t_s), then 1/2 h (a(x, v_pred) - a(t_s)).
+  const Vec2 k1 = w.ksub[i];
+  const Vec2 v_pred = w.vsub[i] + h * k1;
+  PathState s;
+  s.p = w.psub[i] + h * w.vsub[i] + (0.5 * h * h) * k1;
+  s.v = v_pred + (0.5 * h) * (substep_acceleration(w, i, v_pred) - k1);
+  return s;
+}
+
+void end_substep(World& w, std::uint32_t i, double t) {
+  if (!uses_substeps(w, i)) {
+    w.advance(i, t);
+    return;
+  }
+  const PathState s = integrator_state(w, i, t);
+  w.pos[i] = s.p;
+  w.vel[i] = s.v;
+  w.tloc[i] = t;
+}
+
+void start_substep(World& w, std::uint32_t i, double t, double T) {
+  if (!w.alive(i) || !uses_substeps(w, i)) return;
+  w.advance(i, t);
+  const double h = T - t;
+  w.tsub[i] = t;
+  w.psub[i] = w.pos[i];
+  w.vsub[i] = w.vel[i];
+  const Vec2 v = w.vel[i];
+  const Vec2 k1 = substep_acceleration(w, i, v);
+  w.ksub[i] = k1;
+  if (w.integrator == Integrator::VelocityVerlet) {
+    w.apath[i] = k1;   // end_paths adds 1/2 (T - t) (a(end) - k1)
+    return;
+  }
+  const Vec2 k2 = substep_acceleration(w, i, v + (0.5 * h) * k1);
+  const Vec2 k3 = substep_acceleration(w, i, v + (0.5 * h) * k2);
+  const Vec2 k4 = substep_acceleration(w, i, v + h * k3);
+  w.apath[i] = (1.0 / 3.0) * (k1 + k2 + k3);
+  w.vcorr[i] = (h / 6.0) * (k4 - k1);
+}
+
+double refine_static_impact(const World& w, std::uint32_t i, const Segment& seg, bool cap, double t, double t_min,
+                            double T) {
+  if (!needs_impact_refinement(w, i)) return t;
+  const double r = w.radius[i];
+  const Vec2 pt = w.pos_at(i, t);
+  const double ftol = kTolUlps * kEps * (inf_norm(pt) + r);
+  if (cap) {
+    const Vec2 q = length_squared(pt - seg.from) <= length_squared(pt - seg.to) ? seg.from : seg.to;
+    return root_near([&](double s) { return length(position_on_path(w, i, s) - q) - r; }, t, t_min, T, ftol);
+  }
+  // The side the body is on before the impact (a point on the line: the side it moves from).
+  const double D = dot(w.pos[i] - seg.from, seg.normal);
+  const double side = D > 0.0 ? 1.0 : D < 0.0 ? -1.0 : (dot(w.vel[i], seg.normal) < 0.0 ? 1.0 : -1.0);
+  return root_near([&](double s) { return side * dot(position_on_path(w, i, s) - seg.from, seg.normal) - r; }, t,
+                   t_min, T, ftol);
+}
+
+double refine_pair_impact(const World& w, std::uint32_t i, std::uint32_t j, double t, double t_min, double T) {
+  if (!needs_impact_refinement(w, i) && !needs_impact_refinement(w, j)) return t;
+  const double R = w.radius[i] + w.radius[j];
+  const double ftol = kTolUlps * kEps * (inf_norm(w.pos_at(i, t)) + inf_norm(w.pos_at(j, t)) + R);
+  return root_near([&](double s) { return length(position_on_path(w, j, s) - position_on_path(w, i, s)) - R; }, t,
+                   t_min, T, ftol);
+}
+
+double refine_stop(const World& w, std::uint32_t i, double t, double t_min, double T) {
+  if (!uses_substeps(w, i) || !on_face(w, i)) return t;
+  const Vec2 tang = perp(w.support_n[i]);
+  // The direction it slides in: its velocity's (at its last event), or from rest the
+  // direction its acceleration took it.
+  const double vt = dot(w.vel[i], tang);
+  const double dir = (vt != 0.0 ? vt : dot(w.apath[i], tang)) > 0.0 ? 1.0 : -1.0;
+  const double ftol = kTolUlps * kEps * inf_norm(w.vsub[i]);
+  return root_near([&](double s) { return dir * dot(integrator_state(w, i, s).v, tang); }, t, t_min, T, ftol);
+}
+
+double refine_leave(const World& w, std::uint32_t i, double t, double t_min, double T) {
+  if (!needs_impact_refinement(w, i) || !on_face(w, i)) return t;
+  const Segment& seg = w.statics.segments[w.support[i]];
+  // Off the end it is heading for: u < 0 at `from`, u > L at `to`.
+  const Vec2 pt = w.pos_at(i, t);
+  const bool at_from = dot(pt - seg.from, seg.dir) < 0.5 * seg.length;
+  const double ftol = kTolUlps * kEps * inf_norm(pt);
+  return root_near(
+      [&](double s) {
+        const double u = dot(position_on_path(w, i, s) - seg.from, seg.dir);
+        return at_from ? u : seg.length - u;
+      },
+      t, t_min, T, ftol);
+}
+
+}  // namespace physval::core_detail
