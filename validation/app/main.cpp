@@ -74,8 +74,17 @@ struct CommonOptions {
   std::string cache;
   bool no_cache = false;
   std::string shard;   // "I/N"
+  double max_memory_mb = 0.0;
   std::vector<std::string> plugins;
 };
+
+// --max-memory MB: the limit the memory estimate of each scene is held to (0: half of the
+// machine's). NaN and negative values are bad input.
+bool apply_max_memory(double mb) {
+  if (!(mb >= 0.0) || !std::isfinite(mb)) return false;
+  if (mb > 0.0) set_memory_limit_bytes(mb * 1e6);
+  return true;
+}
 
 // --plugin LIB.so (repeatable): an engine plugin, a path or a name searched in PHYSVAL_PLUGIN_PATH.
 void add_plugin_option(CLI::App* cmd, std::vector<std::string>& plugins) {
@@ -95,10 +104,14 @@ void add_common(CLI::App* cmd, CommonOptions& o) {
   cmd->add_option("--dt", o.dt, "override every scenario's step, seconds (1/60 or 0.0166)");
   cmd->add_option("--duration", o.duration, "override every scenario's duration, seconds");
   cmd->add_flag("--no-isolate", o.no_isolate, "run engines in this process (debugging; a crash then ends physval)");
-  cmd->add_option("--timeout", o.timeout, "seconds a single engine run may take before it is stopped (0: no limit)");
+  cmd->add_option("--timeout", o.timeout,
+                  "seconds an engine run and the reference it is compared with may take together; the run is "
+                  "stopped when they exceed it (0: no limit)");
   cmd->add_flag("--quiet", o.quiet, "print only the summary line");
   cmd->add_option("--cache", o.cache, "reference cache folder (default $XDG_CACHE_HOME/physval/references or ~/.cache/...)");
   cmd->add_flag("--no-cache", o.no_cache, "compute every reference, read and write no cache");
+  cmd->add_option("--max-memory", o.max_memory_mb,
+                  "MB a scene's estimated memory may reach (default 0: half of this machine's memory)");
   add_plugin_option(cmd, o.plugins);
   cmd->add_option("-j,--jobs", o.jobs, "references and engine runs at once (default 0: every core); results do not depend on it");
   cmd->add_option("--shard", o.shard,
@@ -208,11 +221,19 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
   if (!(baseline_factor >= 1.0) || !std::isfinite(baseline_factor)) {
     return bad_input("--baseline-factor must be a finite number >= 1");   // NaN too
   }
+  if (!apply_max_memory(o.max_memory_mb)) return bad_input("--max-memory must be a number of MB >= 0");
   auto scenes = load_or_report(o.paths);
   if (!scenes) return kExitBadInput;
   for (const Scene& s : *scenes) {
-    if (const std::string too_many = scene_steps_error(effective_scene(s, options)); !too_many.empty()) {
+    const Scene effective = effective_scene(s, options);
+    if (const std::string too_many = scene_steps_error(effective); !too_many.empty()) {
       return bad_input(s.source_file + ": with --duration/--dt: " + too_many);
+    }
+    if (options.dt || options.duration) {
+      if (const std::string too_big = memory_bound_error(effective, engines_for(effective, o.engines).size());
+          !too_big.empty()) {
+        return bad_input(s.source_file + ": with --duration/--dt: the scene " + too_big + "; nothing was run");
+      }
     }
   }
   nlohmann::json shard_block;
@@ -340,8 +361,11 @@ void print_engines(bool as_json) {
       for (Feature ft : f.info.features) features.push_back(feature_name(ft));
       nlohmann::json options = nlohmann::json::array();
       for (const OptionSpec& s : f.info.options) {
+        const bool numeric = s.default_value.index() == 1 || s.default_value.index() == 2;
         options.push_back({{"key", s.key}, {"type", option_type_name(s.default_value)},
-                           {"default", option_value_to_string(s.default_value)}, {"choices", s.choices}, {"doc", s.doc}});
+                           {"default", option_value_to_string(s.default_value)}, {"choices", s.choices},
+                           {"range", numeric ? nlohmann::json(s.range.describe()) : nlohmann::json(nullptr)},
+                           {"doc", s.doc}});
       }
       out.push_back({{"name", f.info.name}, {"version", f.info.version}, {"precision", precision_name(f.info.precision)},
                      {"summary", f.info.summary}, {"features", features}, {"options", options},
@@ -381,6 +405,7 @@ void print_engines(bool as_json) {
         std::cout << ":";
         for (std::size_t i = 0; i < s.choices.size(); ++i) std::cout << (i ? "|" : " ") << s.choices[i];
       }
+      if (s.default_value.index() == 1 || s.default_value.index() == 2) std::cout << ", " << s.range.describe();
       std::cout << ")  " << s.doc << '\n';
     }
     std::cout << '\n';
@@ -421,8 +446,11 @@ int main(int argc, char** argv) {
   gate->add_flag("--report", gate_report, "also write DIR/report.html with plots");
 
   std::vector<std::string> check_paths;
+  double check_max_memory = 0.0;
   auto* check = app.add_subcommand("check", "parse and validate scenario files; runs nothing");
   check->add_option("PATH", check_paths, "scenario files or folders")->required();
+  check->add_option("--max-memory", check_max_memory,
+                    "MB a scene's estimated memory may reach (default 0: half of this machine's memory)");
   std::vector<std::string> check_plugins;
   add_plugin_option(check, check_plugins);
 
@@ -497,6 +525,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*check) {
+      if (!apply_max_memory(check_max_memory)) return bad_input("--max-memory must be a number of MB >= 0");
       auto scenes = load_or_report(check_paths);
       if (!scenes) return kExitBadInput;
       for (const Scene& s : *scenes) {

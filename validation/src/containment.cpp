@@ -3,97 +3,282 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <numeric>
-#include <utility>
-#include <vector>
 
 namespace physval {
 
 namespace {
 
-bool walls_closed(const Scene& scene) {
-  if (scene.walls.size() < 3) return false;
-  std::vector<Vec2> ends;
-  for (const WallDef& w : scene.walls) {
-    ends.push_back(w.from);
-    ends.push_back(w.to);
-  }
-  for (const Vec2& p : ends) {
-    int meet = 0;
-    for (const Vec2& q : ends) meet += length(p - q) <= 1e-9 ? 1 : 0;
-    if (meet % 2 != 0) return false;
-  }
-  return true;
+constexpr std::size_t kBruteForceBarriers = 16;
+constexpr double kMaxCellsPerBarrier = 4096.0;
+
+std::int64_t cell_index(double x, double inv) {
+  return static_cast<std::int64_t>(std::floor(std::clamp(x * inv, -1e9, 1e9)));
 }
 
-// Even-odd rule over the wall segments.
-bool inside(const Scene& scene, Vec2 p) {
-  bool in = false;
-  for (const WallDef& w : scene.walls) {
-    const Vec2 a = w.from, b = w.to;
-    if ((a.y > p.y) != (b.y > p.y)) {
-      const double x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
-      if (x > p.x) in = !in;
-    }
-  }
-  return in;
+std::uint64_t cell_key(std::int64_t x, std::int64_t y) {
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(x)) << 32) | static_cast<std::uint32_t>(y);
 }
 
-double segment_distance(Vec2 p, Vec2 a, Vec2 b) {
-  const Vec2 ab = b - a;
-  const double len2 = dot(ab, ab);
-  const double t = len2 > 0.0 ? std::clamp(dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
-  return length(p - (a + ab * t));
+double segment_distance(Vec2 p, Vec2 a, Vec2 dir, double len) {
+  const double u = std::clamp(dot(p - a, dir), 0.0, len);
+  return length(p - (a + dir * u));
 }
 
 }  // namespace
 
-Containment measure_containment(const Scene& scene, const Series& series) {
-  Containment c;
-  const std::size_t nb = scene.bodies.size();
-  const bool closed = walls_closed(scene);
-  std::vector<char> was_inside(nb, 0), escaped(nb, 0);
-  if (closed) {
-    for (std::size_t i = 0; i < nb; ++i) was_inside[i] = inside(scene, scene.bodies[i].position) ? 1 : 0;
-    c.escaped_bodies = 0;
+ContainmentMonitor::ContainmentMonitor(const Scene& scene) : scene_(scene) {
+  std::map<std::string, std::size_t> barrier_groups, body_groups;
+  auto group_of = [](std::map<std::string, std::size_t>& m, const std::string& g) {
+    return m.emplace(g, m.size()).first->second;
+  };
+  auto add_segment = [&](Vec2 a, Vec2 b, const StaticMaterial& m, const std::string& what) {
+    Barrier s;
+    s.a = a;
+    s.b = b;
+    s.len = length(b - a);
+    if (!(s.len > 0.0)) return;
+    s.dir = (b - a) / s.len;
+    s.group = group_of(barrier_groups, m.group);
+    s.what = what;
+    barriers_.push_back(std::move(s));
+  };
+  for (const WallDef& w : scene.walls) add_segment(w.from, w.to, w.material, "wall '" + w.name + "'");
+  for (const BoxDef& b : scene.boxes) {
+    const Vec2 c[4] = {b.min, {b.max.x, b.min.y}, b.max, {b.min.x, b.max.y}};
+    for (int k = 0; k < 4; ++k) add_segment(c[k], c[(k + 1) % 4], b.material, "box '" + b.name + "'");
   }
-  std::vector<std::size_t> order;
-  for (std::size_t k = 0; k < series.states.size(); ++k) {
-    const SampleRow& s = series.states[k];
-    const std::size_t n = std::min(s.size(), nb);
-    // Pairs, swept over x.
-    order.resize(n);
-    std::iota(order.begin(), order.end(), std::size_t{0});
-    auto lo = [&](std::size_t i) { return s[i].position.x - scene.bodies[i].radius; };
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return lo(a) < lo(b); });
-    for (std::size_t p = 0; p < n; ++p) {
-      const std::size_t i = order[p];
-      if (!s[i].alive) continue;
-      const double hi = s[i].position.x + scene.bodies[i].radius;
-      for (std::size_t q = p + 1; q < n && lo(order[q]) <= hi; ++q) {
-        const std::size_t j = order[q];
-        if (!s[j].alive) continue;
-        if (!response_between(scene, scene.bodies[i].group, scene.bodies[j].group).collide) continue;
-        const double depth = scene.bodies[i].radius + scene.bodies[j].radius - length(s[i].position - s[j].position);
-        c.max_penetration = std::max(c.max_penetration, depth);
+  for (const SurfaceDef& s : scene.surfaces) {
+    for (std::size_t k = 0; k + 1 < s.points.size(); ++k) {
+      add_segment(s.points[k], s.points[k + 1], s.material, "surface '" + s.name + "'");
+    }
+  }
+  double extent = 1.0, max_radius = 0.0;
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+    const BodyDef& d = scene.bodies[i];
+    const double r = d.shape == ShapeKind::Point ? 0.0 : d.radius;
+    extent = std::max({extent, std::fabs(d.position.x) + r, std::fabs(d.position.y) + r});
+    body_group_.push_back(group_of(body_groups, d.group));
+    if (d.is_static) {
+      if (!(r > 0.0)) continue;   // a static point is nothing to pass through
+      Barrier c;
+      c.circle = true;
+      c.a = c.b = d.position;
+      c.radius = r;
+      c.body = i;
+      c.group = group_of(barrier_groups, d.group);
+      c.what = "static body '" + d.name + "'";
+      barriers_.push_back(std::move(c));
+    } else {
+      moving_.push_back(i);
+      max_radius = std::max(max_radius, r);
+    }
+  }
+  for (const Barrier& b : barriers_) {
+    extent = std::max({extent, std::fabs(b.a.x), std::fabs(b.a.y), std::fabs(b.b.x), std::fabs(b.b.y)});
+  }
+  eps_ = 1e-9 * extent;
+
+  std::vector<std::string> bg_names(barrier_groups.size()), mg_names(body_groups.size());
+  for (const auto& [name, id] : barrier_groups) bg_names[id] = name;
+  for (const auto& [name, id] : body_groups) mg_names[id] = name;
+  n_body_groups_ = mg_names.size();
+  blocks_.assign(n_body_groups_, std::vector<char>(bg_names.size(), 0));
+  pair_collides_.assign(n_body_groups_ * n_body_groups_, 0);
+  for (std::size_t g = 0; g < n_body_groups_; ++g) {
+    for (std::size_t h = 0; h < bg_names.size(); ++h) blocks_[g][h] = response_between(scene, mg_names[g], bg_names[h]).collide;
+    for (std::size_t h = 0; h < n_body_groups_; ++h) {
+      pair_collides_[g * n_body_groups_ + h] = response_between(scene, mg_names[g], mg_names[h]).collide;
+    }
+  }
+  // Escapes apply when some moving body collides with some barrier.
+  bool any = false;
+  for (std::size_t i : moving_) {
+    for (const Barrier& b : barriers_) any = any || blocks_[body_group_[i]][b.group];
+  }
+  if (any) record_.escaped_bodies = 0;
+
+  use_grid_ = barriers_.size() > kBruteForceBarriers;
+  stamp_.assign(barriers_.size(), 0);
+  if (use_grid_) {
+    double total = 0.0;
+    for (const Barrier& b : barriers_) total += b.circle ? 2.0 * b.radius : b.len;
+    cell_ = std::max({total / static_cast<double>(barriers_.size()), 4.0 * max_radius, 1e-6 * extent});
+    const double inv = 1.0 / cell_;
+    for (std::uint32_t k = 0; k < barriers_.size(); ++k) {
+      const Barrier& b = barriers_[k];
+      const double r = b.circle ? b.radius : 0.0;
+      const std::int64_t x0 = cell_index(std::min(b.a.x, b.b.x) - r, inv), x1 = cell_index(std::max(b.a.x, b.b.x) + r, inv);
+      const std::int64_t y0 = cell_index(std::min(b.a.y, b.b.y) - r, inv), y1 = cell_index(std::max(b.a.y, b.b.y) + r, inv);
+      if (static_cast<double>(x1 - x0 + 1) * static_cast<double>(y1 - y0 + 1) > kMaxCellsPerBarrier) {
+        always_.push_back(k);
+        continue;
       }
-      bool walls_hold = true;   // a body its walls let through (collision matrix) cannot escape
-      for (const WallDef& w : scene.walls) {
-        if (!response_between(scene, scene.bodies[i].group, w.material.group).collide) {
-          walls_hold = false;
-          continue;
-        }
-        const double depth = scene.bodies[i].radius - segment_distance(s[i].position, w.from, w.to);
-        c.max_penetration = std::max(c.max_penetration, depth);
-      }
-      if (closed && walls_hold && was_inside[i] && !escaped[i] && !inside(scene, s[i].position)) {
-        escaped[i] = 1;
-        ++*c.escaped_bodies;
-        if (!c.first_escape_time && k < series.time.size()) c.first_escape_time = series.time[k];
+      for (std::int64_t y = y0; y <= y1; ++y) {
+        for (std::int64_t x = x0; x <= x1; ++x) grid_[cell_key(x, y)].push_back(k);
       }
     }
   }
-  return c;
+}
+
+void ContainmentMonitor::candidates(Vec2 lo, Vec2 hi) {
+  found_.clear();
+  if (!use_grid_) {
+    for (std::uint32_t k = 0; k < barriers_.size(); ++k) found_.push_back(k);
+    return;
+  }
+  const double inv = 1.0 / cell_;
+  const std::int64_t x0 = cell_index(lo.x - eps_, inv), x1 = cell_index(hi.x + eps_, inv);
+  const std::int64_t y0 = cell_index(lo.y - eps_, inv), y1 = cell_index(hi.y + eps_, inv);
+  if (static_cast<double>(x1 - x0 + 1) * static_cast<double>(y1 - y0 + 1) > static_cast<double>(barriers_.size())) {
+    for (std::uint32_t k = 0; k < barriers_.size(); ++k) found_.push_back(k);   // a long path: test them all
+    return;
+  }
+  if (++query_ == 0) {
+    std::fill(stamp_.begin(), stamp_.end(), 0);
+    query_ = 1;
+  }
+  for (std::uint32_t k : always_) {
+    stamp_[k] = query_;
+    found_.push_back(k);
+  }
+  for (std::int64_t y = y0; y <= y1; ++y) {
+    for (std::int64_t x = x0; x <= x1; ++x) {
+      const auto it = grid_.find(cell_key(x, y));
+      if (it == grid_.end()) continue;
+      for (std::uint32_t k : it->second) {
+        if (stamp_[k] == query_) continue;
+        stamp_[k] = query_;
+        found_.push_back(k);
+      }
+    }
+  }
+}
+
+void ContainmentMonitor::penetration(double depth, double t, const std::string& what) {
+  if (depth > record_.max_penetration) {
+    record_.max_penetration = depth;
+    record_.max_penetration_time = t;
+    record_.max_penetration_what = what;
+  }
+}
+
+void ContainmentMonitor::start(const std::vector<BodyState>& states) {
+  const std::size_t nb = std::min(states.size(), scene_.bodies.size());
+  previous_.assign(scene_.bodies.size(), Vec2{});
+  previous_alive_.assign(scene_.bodies.size(), 0);
+  escaped_.assign(scene_.bodies.size(), 0);
+  for (std::size_t i = 0; i < nb; ++i) {
+    previous_[i] = states[i].position;
+    previous_alive_[i] = states[i].alive ? 1 : 0;
+  }
+  order_ = moving_;
+  record_.measured = true;
+  observe(0.0, states);
+}
+
+void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states) {
+  const std::size_t nb = std::min(states.size(), scene_.bodies.size());
+  auto radius = [&](std::size_t i) {
+    const BodyDef& d = scene_.bodies[i];
+    return d.shape == ShapeKind::Point ? 0.0 : d.radius;
+  };
+  auto position = [&](std::size_t i) { return i < nb ? states[i].position : scene_.bodies[i].position; };
+  auto alive = [&](std::size_t i) { return i < nb && states[i].alive && is_finite(states[i].position); };
+
+  // Moving pairs: a sweep over x, the order kept from the step before (insertion sort
+  // is linear on an almost sorted list).
+  auto lo = [&](std::size_t i) { return position(i).x - radius(i); };
+  for (std::size_t p = 1; p < order_.size(); ++p) {
+    const std::size_t v = order_[p];
+    const double key = lo(v);
+    std::size_t q = p;
+    while (q > 0 && lo(order_[q - 1]) > key) {
+      order_[q] = order_[q - 1];
+      --q;
+    }
+    order_[q] = v;
+  }
+  for (std::size_t p = 0; p < order_.size(); ++p) {
+    const std::size_t i = order_[p];
+    if (!alive(i)) continue;
+    const Vec2 xi = position(i);
+    const double hi = xi.x + radius(i);
+    for (std::size_t q = p + 1; q < order_.size() && lo(order_[q]) <= hi; ++q) {
+      const std::size_t j = order_[q];
+      if (!alive(j)) continue;
+      if (!pair_collides_[body_group_[i] * n_body_groups_ + body_group_[j]]) continue;
+      const double depth = radius(i) + radius(j) - length(xi - position(j));
+      if (depth > record_.max_penetration) {
+        penetration(depth, t, scene_.bodies[std::min(i, j)].name + " / " + scene_.bodies[std::max(i, j)].name);
+      }
+    }
+  }
+
+  // Each moving body against the barriers near its path since the last step.
+  for (std::size_t i : moving_) {
+    if (!alive(i)) {
+      previous_alive_[i] = 0;
+      continue;
+    }
+    const double r = radius(i);
+    const Vec2 p1 = position(i);
+    const Vec2 p0 = previous_alive_[i] ? previous_[i] : p1;
+    const Vec2 lo_corner{std::min(p0.x, p1.x) - r, std::min(p0.y, p1.y) - r};
+    const Vec2 hi_corner{std::max(p0.x, p1.x) + r, std::max(p0.y, p1.y) + r};
+    candidates(lo_corner, hi_corner);
+    const std::vector<char>& blocks = blocks_[body_group_[i]];
+    for (std::uint32_t k : found_) {
+      const Barrier& b = barriers_[k];
+      if (!blocks[b.group]) continue;
+      if (b.circle) {
+        const double depth = r + b.radius - length(p1 - b.a);
+        if (depth > record_.max_penetration) penetration(depth, t, scene_.bodies[i].name + " / " + b.what);
+      } else {
+        const double depth = r - segment_distance(p1, b.a, b.dir, b.len);
+        if (depth > record_.max_penetration) penetration(depth, t, scene_.bodies[i].name + " / " + b.what);
+      }
+      if (escaped_[i] || p0 == p1) continue;
+      bool through = false;
+      if (b.circle) {
+        const Vec2 d = p1 - p0;
+        const double len2 = dot(d, d);
+        const double u = std::clamp(dot(b.a - p0, d) / len2, 0.0, 1.0);
+        // Into a static body's circle (the centre closer to its centre than its radius):
+        // deeper than the moving body's own radius, through or on its way through.
+        through = length(p0 - b.a) >= b.radius - eps_ && length(p0 + d * u - b.a) < b.radius - eps_;
+      } else {
+        const double d0 = cross(b.dir, p0 - b.a), d1 = cross(b.dir, p1 - b.a);
+        const int s0 = d0 > eps_ ? 1 : d0 < -eps_ ? -1 : 0;
+        const int s1 = d1 > eps_ ? 1 : d1 < -eps_ ? -1 : 0;
+        auto within = [&](Vec2 q) {
+          const double u = dot(q - b.a, b.dir);
+          return u >= -eps_ && u <= b.len + eps_;
+        };
+        const std::uint64_t key = static_cast<std::uint64_t>(i) * barriers_.size() + k;
+        if (s0 != 0 && s1 == -s0) {
+          through = within(p0 + (p1 - p0) * (d0 / (d0 - d1)));
+        } else if (s0 != 0 && s1 == 0) {
+          if (within(p1)) on_line_[key] = static_cast<signed char>(s0);   // landed on the line: remember whence
+        } else if (s0 == 0) {
+          // Left the line it had landed on: through it when to the other side of where it came from.
+          if (auto it = on_line_.find(key); it != on_line_.end() && s1 != 0) {
+            through = s1 == -it->second && within(p0);
+            on_line_.erase(it);
+          }
+        }
+      }
+      if (through) {
+        escaped_[i] = 1;
+        ++*record_.escaped_bodies;
+        if (!record_.first_escape_time) {
+          record_.first_escape_time = t;
+          record_.first_escape = scene_.bodies[i].name + " through " + b.what;
+        }
+      }
+    }
+    previous_[i] = p1;
+    previous_alive_[i] = 1;
+  }
 }
 
 }  // namespace physval

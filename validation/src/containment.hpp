@@ -1,25 +1,82 @@
-// Containment, from the sampled states: how deep bodies overlap each other or a wall
-// (max_penetration) and which bodies left the region their walls enclose
-// (escaped_bodies). Documented in the README ("Metrics").
+// Containment, measured after every engine step by the runner (inside the engine's child
+// process): how deep bodies overlap each other or a barrier (max_penetration) and which
+// bodies passed through a barrier they collide with (escaped_bodies). Documented in the
+// README ("Metrics").
+//
+// Barriers are every static thing a scene can describe: walls, the four sides of each box,
+// each segment of each surface, and static bodies (circles). A body escapes when the
+// straight path of its centre from one step to the next crosses a barrier segment (from
+// more than eps on one side of its line to more than eps on the other, at a point of the
+// segment, within eps of its ends; a body that lands within eps of the line and later
+// leaves it to the other side crosses too) or enters a static body's circle (the path,
+// starting outside it, comes closer than its radius - eps to its centre), eps = 1e-9 x the
+// scene's extent (at least 1 m). A closed container of any shape (a loop of walls, a box,
+// closed surfaces, a mix) can be left only that way, and a body stepping over a thin wall
+// is caught the same way. Pairs the collision matrix lets through (ignore, event) are left
+// out. Particles (bodies created while the scene runs) are not followed.
 #pragma once
 
-#include <optional>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <unordered_map>
+#include <vector>
 
 #include "physval/core/scene.hpp"
 #include "physval/validation/run_record.hpp"
 
 namespace physval {
 
-struct Containment {
-  double max_penetration = 0.0;             // m, deepest overlap at any sample
-  std::optional<int> escaped_bodies;        // only when the walls enclose a region
-  std::optional<double> first_escape_time;  // s, the first sample a body was outside
-};
+class ContainmentMonitor {
+ public:
+  explicit ContainmentMonitor(const Scene& scene);
 
-// The enclosed region: the walls form closed loops (every wall end meets an even number
-// of wall ends, within 1e-9 m); a point is inside when a ray from it crosses the walls an
-// odd number of times. A scene body inside at t = 0 escapes when, at a later sample, it
-// is alive and its centre is outside.
-Containment measure_containment(const Scene& scene, const Series& series);
+  // The state at t = 0 (every body's starting point).
+  void start(const std::vector<BodyState>& states);
+  // The state after a step that ended at time t.
+  void observe(double t, const std::vector<BodyState>& states);
+
+  const ContainmentRecord& record() const { return record_; }
+
+ private:
+  struct Barrier {
+    bool circle = false;
+    Vec2 a, b;        // segment ends; a circle's centre is a
+    Vec2 dir;         // unit, a -> b
+    double len = 0.0;
+    double radius = 0.0;   // circles
+    std::size_t group = 0;   // index into barrier groups
+    std::size_t body = static_cast<std::size_t>(-1);   // a static body's index
+    std::string what;      // "wall 'left'"
+  };
+  void candidates(Vec2 lo, Vec2 hi);
+  void penetration(double depth, double t, const std::string& what);
+
+  const Scene& scene_;
+  std::vector<Barrier> barriers_;
+  std::vector<std::vector<char>> blocks_;   // [body group][barrier group]: they collide
+  std::vector<std::size_t> body_group_;     // scene body -> body group
+  std::vector<char> pair_collides_;         // [body group x body group]
+  std::size_t n_body_groups_ = 0;
+  std::vector<std::size_t> moving_;         // scene bodies that are not static
+  std::vector<std::size_t> order_;          // moving_, kept sorted by x - radius
+  double eps_ = 1e-9;
+
+  // A uniform grid over the barriers (used when there are many).
+  bool use_grid_ = false;
+  double cell_ = 1.0;
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> grid_;
+  std::vector<std::uint32_t> always_;       // barriers too large for the grid
+  std::vector<std::uint32_t> stamp_;
+  std::uint32_t query_ = 0;
+  std::vector<std::uint32_t> found_;
+
+  // (body, barrier segment) -> the side a body came from when it landed within eps of
+  // the segment's line: leaving to the other side later is a crossing too.
+  std::unordered_map<std::uint64_t, signed char> on_line_;
+  std::vector<Vec2> previous_;
+  std::vector<char> previous_alive_, escaped_;
+  ContainmentRecord record_;
+};
 
 }  // namespace physval

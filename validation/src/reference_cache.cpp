@@ -89,6 +89,7 @@ json reference_to_json(const std::string& key, const Reference& ref) {
   j["reason"] = ref.reason;
   j["dt"] = ref.dt;
   j["convergence_error"] = ref.convergence_error;
+  j["seconds"] = ref.seconds;
   j["run"] = ref.run ? json::binary(encode_run_record(*ref.run)) : json(nullptr);
   return j;
 }
@@ -103,6 +104,7 @@ std::optional<Reference> reference_from(const std::string& bytes, const std::str
     ref.reason = j.at("reason").get<std::string>();
     ref.dt = j.at("dt").get<double>();
     ref.convergence_error = j.at("convergence_error").get<double>();
+    ref.seconds = j.at("seconds").get<double>();
     if (!j.at("run").is_null()) ref.run = decode_run_record(j.at("run").get_binary());
     return ref;
   } catch (const std::exception&) {

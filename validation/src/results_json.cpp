@@ -85,6 +85,7 @@ json run_to_json_without_lists(const RunRecord& r) {
           {"status", run_status_name(r.status)},
           {"reason", r.reason},
           {"diverged_at", opt(r.diverged_at)},
+          {"known_divergence", r.known_divergence},
           {"wall_seconds", r.wall_seconds},
           {"load_seconds", r.load_seconds},
           {"settings", settings},

@@ -114,6 +114,15 @@ void write_record(Sink& sink, const RunRecord& r) {
   }
   w.u64(r.final_states.size());
   for (const BodyState& s : r.final_states) w.state(s);
+  const ContainmentRecord& c = r.containment;
+  w.b(c.measured);
+  w.f64(c.max_penetration);
+  w.opt(c.max_penetration_time);
+  w.str(c.max_penetration_what);
+  w.b(c.escaped_bodies.has_value());
+  w.i64(c.escaped_bodies.value_or(0));
+  w.opt(c.first_escape_time);
+  w.str(c.first_escape);
   w.u64(kMagic);
 }
 
@@ -360,6 +369,16 @@ RunRecord read_record(Source& source) {
   const std::uint64_t nf = rd.count();
   reserve_some(r.final_states, nf);
   for (std::uint64_t i = 0; i < nf; ++i) r.final_states.push_back(rd.state());
+  ContainmentRecord& c = r.containment;
+  c.measured = rd.b();
+  c.max_penetration = rd.f64();
+  c.max_penetration_time = rd.opt();
+  c.max_penetration_what = rd.str();
+  const bool has_escaped = rd.b();
+  const std::int64_t escaped = rd.i64();
+  if (has_escaped) c.escaped_bodies = static_cast<int>(escaped);
+  c.first_escape_time = rd.opt();
+  c.first_escape = rd.str();
   if (rd.u64() != kMagic) throw std::runtime_error("run record: malformed (no end mark)");
   return r;
 }

@@ -17,6 +17,13 @@ double estimated_cost(const Scene& scene) {
   return static_cast<double>(std::max<std::size_t>(1, scene.bodies.size())) * static_cast<double>(scene.steps());
 }
 
+std::string seconds_text(double seconds) {
+  std::ostringstream os;
+  os.precision(3);
+  os << seconds;   // 20 -> "20", 0.5 -> "0.5", 1.23456 -> "1.23"
+  return os.str();
+}
+
 }  // namespace
 
 SuiteResult run_suite(std::vector<Scene> scenes, const std::vector<std::string>& engines,
@@ -65,16 +72,49 @@ SuiteResult run_suite(std::vector<Scene> scenes, const std::vector<std::string>&
     const std::string what = result.scenarios[t.scenario].scene.name + ": " + (t.engine ? t.engine->info.name : "reference");
     progress(what);   // the caller counts scenarios (physval's "[n/N]")
   };
-  run_tasks(costs, jobs, [&](std::size_t i) {
-    const Task& t = tasks[i];
-    ScenarioResult& sr = result.scenarios[t.scenario];
-    say(t);
-    if (t.engine == nullptr) {
-      sr.reference = cached_reference(sr.scene, options).reference;
-    } else {
-      sr.runs[t.slot] = run_engine_isolated(sr.scene, *t.engine, options);
+  // References first, then the engine runs: one --timeout is the budget of an engine run
+  // together with the reference it is compared with, so each engine run gets what its
+  // scenario's reference left of it (README: "--timeout").
+  for (const bool references : {true, false}) {
+    std::vector<std::size_t> phase;
+    std::vector<double> phase_costs;
+    for (std::size_t i = 0; i < tasks.size(); ++i) {
+      if ((tasks[i].engine == nullptr) != references) continue;
+      phase.push_back(i);
+      phase_costs.push_back(costs[i]);
     }
-  });
+    run_tasks(phase_costs, jobs, [&](std::size_t k) {
+      const Task& t = tasks[phase[k]];
+      ScenarioResult& sr = result.scenarios[t.scenario];
+      say(t);
+      if (t.engine == nullptr) {
+        sr.reference = cached_reference(sr.scene, options).reference;
+        return;
+      }
+      if (options.timeout_seconds <= 0.0) {
+        sr.runs[t.slot] = run_engine_isolated(sr.scene, *t.engine, options);
+        return;
+      }
+      RunOptions budget = options;
+      const double spent = sr.reference.seconds;
+      budget.timeout_seconds = options.timeout_seconds - spent;
+      RunRecord r;
+      if (budget.timeout_seconds <= 0.0) {
+        r = unsupported_run(sr.scene, t.engine->info, {});
+        r.status = RunStatus::Error;
+        r.reason = "timed out: the reference took " + seconds_text(spent) + " s of the --timeout budget of " +
+                   seconds_text(options.timeout_seconds) + " s, nothing was left for this run";
+      } else {
+        r = run_engine_isolated(sr.scene, *t.engine, budget);
+        if (r.status == RunStatus::Error && r.reason.rfind("timed out", 0) == 0 && spent > 0.0) {
+          r.reason = "timed out: the engine run and the reference (" + seconds_text(spent) +
+                     " s) together took longer than the --timeout budget of " +
+                     seconds_text(options.timeout_seconds) + " s";
+        }
+      }
+      sr.runs[t.slot] = std::move(r);
+    });
+  }
 
   // Comparisons, per scenario (independent of each other).
   std::vector<double> compare_costs;

@@ -20,6 +20,9 @@ struct Reference {
   double dt = 0.0;                  // the finer of the two resolutions
   double convergence_error = 0.0;   // max position difference between them, m
   std::optional<RunRecord> run;     // the finer run
+  // Wall-clock seconds its runs took when it was computed (kept in the reference cache,
+  // so a reference read back is charged the same): --timeout's budget counts it.
+  double seconds = 0.0;
 };
 
 // Builds the reference for `scene` (already effective: dt/duration applied).

@@ -93,6 +93,18 @@ struct Check {
 
 using Metrics = std::map<std::string, std::optional<double>>;
 
+// Containment, measured by the runner after every engine step (not only at samples):
+// see containment.hpp and the README ("Metrics").
+struct ContainmentRecord {
+  bool measured = false;                    // false: the run took no step (or predates it)
+  double max_penetration = 0.0;             // m, deepest overlap after any step
+  std::optional<double> max_penetration_time;   // s, when it was deepest (nullopt: never > 0)
+  std::string max_penetration_what;         // "a / b", "ball / wall 'floor'"
+  std::optional<int> escaped_bodies;        // nullopt: no barrier any scene body collides with
+  std::optional<double> first_escape_time;  // s, the end of the step the first escape happened in
+  std::string first_escape;                 // "ball through wall 'left'"
+};
+
 struct RunRecord {
   std::string scenario;
   std::string engine;
@@ -104,6 +116,10 @@ struct RunRecord {
   RunStatus status = RunStatus::Ok;
   std::string reason;
   std::optional<double> diverged_at;   // simulated time, s
+  // Diverged only by bodies passing through barriers, no more of them than the scene's
+  // [gate.<engine>] known_failures accepts (escaped_bodies = N): still `diverged`, but it
+  // passes (a known failure, like a known expectation miss).
+  bool known_divergence = false;
   double wall_seconds = 0.0;           // time inside step() only
   double load_seconds = 0.0;
   std::vector<Setting> settings;
@@ -113,6 +129,7 @@ struct RunRecord {
   std::vector<Probe> probes;
   Series series;
   std::vector<BodyState> final_states;
+  ContainmentRecord containment;
 
   Metrics metrics;
   std::vector<Check> checks;

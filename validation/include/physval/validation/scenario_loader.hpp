@@ -33,4 +33,19 @@ struct SuiteLoad {
 // Scenario names must be unique across the suite.
 SuiteLoad load_suite(const std::vector<std::string>& paths);
 
+// Memory a run of `scene` needs, estimated before anything runs (README: "Bounds"): per
+// scene body (the file's parsed tree and the scene), per particle its emitters can make
+// (the engine's state), and per stored state sample (samples x objects: the runs' series
+// and, passing from an engine's process to physval's, their decoded form), with the
+// bytes of each measured on physval itself. `engines`: the engine runs held besides the
+// reference's.
+double estimated_memory_bytes(const Scene& scene, std::size_t engines);
+
+// The limit `check`, `run` and `gate` hold that estimate to (bytes): --max-memory, or by
+// default half of this machine's physical memory.
+void set_memory_limit_bytes(double bytes);
+double memory_limit_bytes();
+// Empty when the estimate fits the limit; else the message (how much against how much).
+std::string memory_bound_error(const Scene& scene, std::size_t engines);
+
 }  // namespace physval
