@@ -80,7 +80,7 @@ TEST(Memory, HarnessHoldsUnderOneKilobyteABodyOnA100kBodyRun) {
   fs::remove_all(root);
   fs::create_directories(root);
   constexpr std::size_t kBodies = 100000;
-  physval::ScenarioLoad load = physval::parse_scenario(gas(kBodies, 15), "gas.toml");
+  physval::ScenarioLoad load = physval::parse_scenario(gas(kBodies, 8), "gas.toml");
   ASSERT_TRUE(load.scene);
   std::vector<physval::Scene> scenes{std::move(*load.scene)};
   load = physval::ScenarioLoad{};
