@@ -261,6 +261,7 @@ SuiteResult suite_from_json(const json& results) {
     run.status = status_from_name(r.at("status").get<std::string>());
     run.reason = r.value("reason", "");
     run.wall_seconds = r.value("wall_seconds", 0.0);
+    run.known_divergence = r.value("known_divergence", false);   // a diverged run a gate accepts
     for (const json& c : r.value("checks", json::array())) {
       Check check;
       check.what = c.at("what").get<std::string>();

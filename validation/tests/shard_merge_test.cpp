@@ -95,7 +95,9 @@ class ShardMerge : public ::testing::Test {
     fs::remove_all(root);
     suite = root / "suite";
     for (const char* f : {"basics/head_on_elastic.toml", "basics/equal_mass_swap.toml", "basics/free_fall_floor.toml",
-                          "models/projectile.toml", "models/drag_wind.toml", "models/box_obstacle.toml"}) {
+                          "models/projectile.toml", "models/drag_wind.toml", "models/box_obstacle.toml",
+                          // bullet's tunnelling: a divergence its gate accepts (known_divergence)
+                          "hard/tunnelling_thin_wall_offgrid.toml"}) {
       fs::create_directories(suite / fs::path(f).parent_path());
       fs::copy_file(fs::path(PHYSVAL_SOURCE_SCENARIOS) / f, suite / f);
     }
