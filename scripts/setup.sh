@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian packages physval builds and runs with, where missing.
 # Run as root on Debian bookworm (the README's two commands call it).
+#   scripts/setup.sh           what physval builds and runs with
+#   scripts/setup.sh --slurm   only the one-node Slurm cluster of scripts/test-slurm.sh
 set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
@@ -11,6 +13,14 @@ packages=(
   python3
   clang-14 libclang-rt-14-dev
 )
+if [ "${1:-}" = --slurm ]; then
+  # slurmctld, slurmd and their clients (sbatch, sinfo), munge for authentication;
+  # python3 compares the results. Nothing here is needed to build or run physval.
+  packages=(slurmctld slurmd slurm-client munge python3)
+elif [ -n "${1:-}" ]; then
+  echo "setup: unknown option $1 (none, or --slurm)" >&2
+  exit 2
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -26,6 +26,8 @@
 #include "physval/validation/suite.hpp"
 #include "physval/validation/reference_cache.hpp"
 #include "physval/validation/scheduler.hpp"
+#include "physval/validation/merge.hpp"
+#include "physval/validation/shard.hpp"
 #include "physval/validation/sweep.hpp"
 
 namespace {
@@ -71,6 +73,7 @@ struct CommonOptions {
   int jobs = 0;   // 0: every core
   std::string cache;
   bool no_cache = false;
+  std::string shard;   // "I/N"
   double max_memory_mb = 0.0;
   std::vector<std::string> plugins;
 };
@@ -111,6 +114,9 @@ void add_common(CLI::App* cmd, CommonOptions& o) {
                   "MB a scene's estimated memory may reach (default 0: half of this machine's memory)");
   add_plugin_option(cmd, o.plugins);
   cmd->add_option("-j,--jobs", o.jobs, "references and engine runs at once (default 0: every core); results do not depend on it");
+  cmd->add_option("--shard", o.shard,
+                  "run only part I of N (0 <= I < N) of the scenarios, split by estimated cost; "
+                  "join the parts' --out folders with `physval merge`");
 }
 
 int bad_input(const std::string& message) {
@@ -192,6 +198,12 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
   }
   if (!(o.timeout >= 0.0)) return bad_input("--timeout must be a number >= 0");   // also NaN
   if (o.jobs < 0) return bad_input("--jobs must be >= 0 (0: every core)");
+  std::optional<ShardSpec> shard;
+  if (!o.shard.empty()) {
+    std::string error;
+    shard = parse_shard(o.shard, error);
+    if (!shard) return bad_input(error);
+  }
   options.isolate = !o.no_isolate;
   if (!o.no_cache) options.reference_cache = o.cache.empty() ? default_reference_cache_dir().string() : o.cache;
   options.timeout_seconds = o.timeout;
@@ -224,6 +236,46 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
       }
     }
   }
+  nlohmann::json shard_block;
+  if (shard) {
+    // Every shard computes the same split from the whole suite; results.json records it
+    // (with what the results depend on) so that `physval merge` can check the parts.
+    std::vector<double> costs;
+    for (const Scene& s : *scenes) {
+      const Scene e = effective_scene(s, options);
+      std::size_t runnable = 0;
+      for (const EngineFactory* f : engines_for(e, o.engines)) runnable += unsupported_features(f->info, e).empty() ? 1 : 0;
+      costs.push_back(scenario_cost(e, runnable));
+    }
+    const std::vector<std::size_t> assigned = assign_shards(costs, shard->count);
+    nlohmann::json list = nlohmann::json::array();
+    std::vector<Scene> mine;
+    double my_cost = 0.0, total_cost = 0.0;
+    for (std::size_t i = 0; i < scenes->size(); ++i) {
+      const Scene& s = (*scenes)[i];
+      list.push_back({{"name", s.name}, {"file", file_fingerprint(s.source_file)}, {"shard", assigned[i]}, {"cost", costs[i]}});
+      total_cost += costs[i];
+      if (assigned[i] == shard->index) {
+        mine.push_back(s);
+        my_cost += costs[i];
+      }
+    }
+    nlohmann::json run_options = {
+        {"engines", o.engines},
+        {"plugins", o.plugins},
+        {"dt", options.dt ? nlohmann::json(*options.dt) : nlohmann::json(nullptr)},
+        {"duration", options.duration ? nlohmann::json(*options.duration) : nlohmann::json(nullptr)},
+        {"timeout", o.timeout},
+        {"isolate", options.isolate},
+        {"baseline", baseline_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(file_fingerprint(baseline_path))},
+        {"baseline_factor", baseline.is_null() ? nlohmann::json(nullptr) : nlohmann::json(baseline_factor)}};
+    shard_block = {{"index", shard->index},   {"count", shard->count},   {"command", gate ? "gate" : "run"},
+                   {"options", run_options}, {"scenarios", list}};
+    std::cout << "shard " << shard->index << "/" << shard->count << ": " << mine.size() << " of " << scenes->size()
+              << " scenarios (" << (total_cost > 0.0 ? static_cast<int>(100.0 * my_cost / total_cost + 0.5) : 0)
+              << "% of the estimated cost)\n";
+    *scenes = std::move(mine);
+  }
   // --out is checked (and a staging folder made beside it) before anything runs.
   std::optional<StagedOutputFolder> out;
   try {
@@ -234,8 +286,11 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
 
   const Progress progress = terminal_progress(o.quiet);
   const std::size_t jobs = o.jobs > 0 ? static_cast<std::size_t>(o.jobs) : default_jobs();
-  SuiteResult result = run_suite(*scenes, o.engines, options, gate, suite_progress(o.quiet, scenes->size()), jobs);
+  const bool no_scenes = scenes->empty();
+  const Progress suite_line = suite_progress(o.quiet, scenes->size());
+  SuiteResult result = run_suite(std::move(*scenes), o.engines, options, gate, suite_line, jobs);
   end_progress(progress);
+  result.shard = shard_block;
   if (!baseline_path.empty()) {
     const int matched = apply_baseline(result, baseline, baseline_factor);
     std::cout << "baseline: " << matched << " runs matched in " << baseline_path << " (regression factor "
@@ -250,7 +305,7 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
       return kExitBadInput;
     }
   }
-  if (gate) {
+  if (gate && !(shard && no_scenes)) {   // a shard may be left without scenarios (N > suite)
     std::size_t checked = 0;
     for (const ScenarioResult& sr : result.scenarios) {
       for (const RunRecord& r : sr.runs) checked += r.status == RunStatus::Unsupported ? 0 : 1;
@@ -426,10 +481,21 @@ int main(int argc, char** argv) {
   int sweep_jobs = 0;
   sweep->add_option("-j,--jobs", sweep_jobs, "error runs at once (default 0: every core); timing runs are always alone");
   sweep->add_option("--timeout", sweep_timeout, "seconds a single measured run may take before it is stopped (0: no limit)");
+  std::string sweep_shard;
+  sweep->add_option("--shard", sweep_shard,
+                    "sweep only part I of N (0 <= I < N) of the points, split by estimated cost; "
+                    "join the parts' --out folders with `physval merge`");
 
   std::string report_dir;
   auto* report = app.add_subcommand("report", "write report.html with plots for a results folder of `run` or `gate`");
   report->add_option("DIR", report_dir, "the folder holding results.json and series/")->required();
+
+  MergeOptions merge_opts;
+  auto* merge = app.add_subcommand("merge", "join the output folders of `--shard I/N` runs (or sweeps) into one, as a single run writes it");
+  merge->add_option("DIR", merge_opts.dirs, "every shard's output folder (each holds results.json or sweep.json)")->required();
+  merge->add_option("--out", merge_opts.out, "the merged folder (default: physval-out, or physval-sweep for sweeps)");
+  merge->add_option("--junit", merge_opts.junit, "also write JUnit XML here, as `gate --junit` does");
+  merge->add_flag("--report", merge_opts.report, "also write OUT/report.html with plots");
 
   bool engines_json = false;
   auto* engines = app.add_subcommand("engines", "each engine, its version, precision, options and what it can model");
@@ -469,6 +535,7 @@ int main(int argc, char** argv) {
       std::cout << scenes->size() << " scenario" << (scenes->size() == 1 ? "" : "s") << " valid\n";
       return 0;
     }
+    if (*merge) return merge_shards(merge_opts, std::cout, std::cerr);
     if (*engines) {
       print_engines(engines_json);
       return 0;
@@ -515,6 +582,13 @@ int main(int argc, char** argv) {
       if (sweep_jobs < 0) return bad_input("--jobs must be >= 0 (0: every core)");
       so.jobs = sweep_jobs > 0 ? static_cast<std::size_t>(sweep_jobs) : default_jobs();
       if (!sweep_no_cache) so.reference_cache = sweep_cache.empty() ? default_reference_cache_dir().string() : sweep_cache;
+      if (!sweep_shard.empty()) {
+        std::string error;
+        const std::optional<ShardSpec> spec = parse_shard(sweep_shard, error);
+        if (!spec) return bad_input(error);
+        so.shard_index = spec->index;
+        so.shard_count = spec->count;
+      }
       so.engines = sweep_engines;
       so.repetitions = sweep_repetitions;
       so.settings = !sweep_no_settings;
@@ -532,7 +606,21 @@ int main(int argc, char** argv) {
       const Progress progress = terminal_progress(sweep_quiet);
       SweepResult result = run_sweep(*load.scene, so, progress);
       end_progress(progress);
-      if (result.points.empty()) {
+      if (so.shard_count > 1) {
+        // What the points depend on, for `physval merge` to compare the shards with.
+        result.shard["command"] = "sweep";
+        result.shard["scenario"] = {{"name", load.scene->name}, {"file", file_fingerprint(sweep_scenario)}};
+        result.shard["options"] = {{"dt", so.dts},
+                                   {"engines", so.engines},
+                                   {"plugins", sweep_plugins},
+                                   {"repetitions", so.repetitions},
+                                   {"settings", so.settings},
+                                   {"duration", load.scene->duration},
+                                   {"timeout", so.timeout_seconds}};
+        std::cout << "shard " << so.shard_index << "/" << so.shard_count << ": " << result.points.size() << " of "
+                  << result.shard["points"].size() << " points\n";
+      }
+      if (result.points.empty() && so.shard_count <= 1) {
         // Nothing was measured (every engine left out): no table, and not a success.
         for (const std::string& note : result.notes) std::cerr << "physval: " << note << '\n';
         std::cerr << "physval: sweep measured nothing: no engine given can model " << load.scene->name << '\n';

@@ -50,8 +50,8 @@ SeriesDivergence series_divergence(const Series& run, const Series& ref, double 
   // and agree again at the next paired sample) is left out of the energy and momentum
   // comparison; a destruction that really differs still differs at the next sample.
   auto same_alive = [&](std::size_t k) {
-    const std::vector<BodyState>& sa = run.states[k];
-    const std::vector<BodyState>& sb = ref.states[static_cast<std::size_t>(pairs[k])];
+    const SampleRow& sa = run.states[k];
+    const SampleRow& sb = ref.states[static_cast<std::size_t>(pairs[k])];
     if (sa.size() != sb.size()) return false;
     for (std::size_t i = 0; i < sa.size(); ++i) {
       if (sa[i].alive != sb[i].alive) return false;
@@ -63,8 +63,8 @@ SeriesDivergence series_divergence(const Series& run, const Series& ref, double 
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     if (pairs[k] < 0) continue;
     const auto j = static_cast<std::size_t>(pairs[k]);
-    const std::vector<BodyState>& sa = run.states[k];
-    const std::vector<BodyState>& sb = ref.states[j];
+    const SampleRow& sa = run.states[k];
+    const SampleRow& sb = ref.states[j];
     const std::size_t bodies = std::min({sa.size(), sb.size(), scene_bodies});
     for (std::size_t i = 0; i < bodies; ++i) {
       if (!sa[i].alive || !sb[i].alive) continue;
@@ -328,11 +328,23 @@ Reference make_reference(const Scene& scene, const RunOptions& options) {
     ro.deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                          std::chrono::duration<double>(ro.timeout_seconds));
   }
-  const Scene fine = variant(refine);
-  const Scene coarse = variant(refine / 2);
+  // One variant of the scene at a time, released once its child has forked: a copy of
+  // a large scene is hundreds of bytes a body.
+  struct Variant {
+    double dt;
+  } fine{0.0}, coarse{0.0};
   const auto started = std::chrono::steady_clock::now();
-  RunRecord fine_run = run_engine_isolated(fine, *engine, ro);
-  RunRecord coarse_run = fine_run.status == RunStatus::Ok ? run_engine_isolated(coarse, *engine, ro) : fine_run;
+  RunRecord fine_run, coarse_run;
+  {
+    Scene s = variant(refine);
+    fine.dt = s.dt;
+    fine_run = run_engine_isolated(std::move(s), *engine, ro);
+  }
+  {
+    Scene s = variant(refine / 2);
+    coarse.dt = s.dt;
+    coarse_run = fine_run.status == RunStatus::Ok ? run_engine_isolated(std::move(s), *engine, ro) : fine_run;
+  }
   ref.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   ref.dt = fine.dt;
   if (fine_run.status != RunStatus::Ok || coarse_run.status != RunStatus::Ok) {

@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
+#include <functional>
+#include <map>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -58,19 +60,16 @@ json context_json() {
           {"engines", engines}};
 }
 
-json run_to_json(const RunRecord& r) {
+namespace {
+
+json final_state_json(const RunRecord& r, std::size_t i) {
+  const BodyState& s = r.final_states[i];
+  return {{"body", r.bodies[i].name}, {"position", vec(s.position)}, {"velocity", vec(s.velocity)}, {"alive", s.alive}};
+}
+
+json run_to_json_without_lists(const RunRecord& r) {
   json metrics = json::object();
   for (const auto& [k, v] : r.metrics) metrics[k] = opt(v);
-  json contacts = json::array();
-  for (const ContactRecord& c : r.contacts) contacts.push_back({{"a", c.a}, {"b", c.b}, {"time", c.time}, {"step", c.step}});
-  json final_states = json::array();
-  for (std::size_t i = 0; i < r.final_states.size() && i < r.bodies.size(); ++i) {
-    const BodyState& s = r.final_states[i];
-    final_states.push_back({{"body", r.bodies[i].name},
-                            {"position", vec(s.position)},
-                            {"velocity", vec(s.velocity)},
-                            {"alive", s.alive}});
-  }
   json checks = json::array();
   for (const Check& c : r.checks) {
     checks.push_back({{"what", c.what}, {"limit", c.limit}, {"value", opt(c.value)}, {"pass", c.pass}, {"enforced", c.enforced}});
@@ -93,39 +92,68 @@ json run_to_json(const RunRecord& r) {
           {"settings", settings},
           {"limits_hit", r.limits_hit},
           {"metrics", metrics},
-          {"contacts", contacts},
-          {"final", final_states},
           {"checks", checks}};
 }
 
-json suite_to_json(const SuiteResult& result) {
-  json runs = json::array(), references = json::array(), comparisons = json::array();
+}  // namespace
+
+json run_to_json(const RunRecord& r) {
+  json j = run_to_json_without_lists(r);
+  json contacts = json::array();
+  for (const ContactRecord& c : r.contacts) contacts.push_back({{"a", c.a}, {"b", c.b}, {"time", c.time}, {"step", c.step}});
+  json final_states = json::array();
+  for (std::size_t i = 0; i < r.final_states.size() && i < r.bodies.size(); ++i) final_states.push_back(final_state_json(r, i));
+  j["contacts"] = std::move(contacts);
+  j["final"] = std::move(final_states);
+  return j;
+}
+
+namespace {
+
+json reference_json_without_contacts(const ScenarioResult& sr) {
+  return {{"scenario", sr.scene.name},
+          {"available", sr.reference.available},
+          {"converged", sr.reference.converged},
+          {"reason", sr.reference.reason},
+          {"dt", sr.reference.dt},
+          {"convergence_error", sr.reference.convergence_error}};
+}
+
+json suite_to_json_without_lists(const SuiteResult& result) {
+  json comparisons = json::array();
   for (const ScenarioResult& sr : result.scenarios) {
-    for (const RunRecord& r : sr.runs) runs.push_back(run_to_json(r));
-    json ref = {{"scenario", sr.scene.name},
-                {"available", sr.reference.available},
-                {"converged", sr.reference.converged},
-                {"reason", sr.reference.reason},
-                {"dt", sr.reference.dt},
-                {"convergence_error", sr.reference.convergence_error}};
-    json contacts = json::array();
-    if (sr.reference.run) {
-      for (const ContactRecord& c : sr.reference.run->contacts) contacts.push_back({{"a", c.a}, {"b", c.b}, {"time", c.time}});
-    }
-    ref["contacts"] = contacts;
-    references.push_back(ref);
     for (const PairComparison& p : sr.pairs) {
       json m = json::object();
       for (const auto& [k, v] : p.metrics) m[k] = opt(v);
       comparisons.push_back({{"scenario", p.scenario}, {"a", p.a}, {"b", p.b}, {"metrics", m}});
     }
   }
-  return {{"physval_version", PHYSVAL_VERSION},
-          {"context", context_json()},
-          {"gates_enforced", result.gates_enforced},
-          {"runs", runs},
-          {"references", references},
-          {"comparisons", comparisons}};
+  json out = {{"physval_version", PHYSVAL_VERSION},
+              {"context", context_json()},
+              {"gates_enforced", result.gates_enforced},
+              {"comparisons", comparisons}};
+  if (!result.shard.is_null()) out["shard"] = result.shard;
+  return out;
+}
+
+}  // namespace
+
+json suite_to_json(const SuiteResult& result) {
+  json runs = json::array(), references = json::array();
+  for (const ScenarioResult& sr : result.scenarios) {
+    for (const RunRecord& r : sr.runs) runs.push_back(run_to_json(r));
+    json ref = reference_json_without_contacts(sr);
+    json contacts = json::array();
+    if (sr.reference.run) {
+      for (const ContactRecord& c : sr.reference.run->contacts) contacts.push_back({{"a", c.a}, {"b", c.b}, {"time", c.time}});
+    }
+    ref["contacts"] = contacts;
+    references.push_back(ref);
+  }
+  json out = suite_to_json_without_lists(result);
+  out["runs"] = std::move(runs);
+  out["references"] = std::move(references);
+  return out;
 }
 
 void write_file_atomically(const std::filesystem::path& path, const std::string& text) {
@@ -273,7 +301,142 @@ void write_results(const std::filesystem::path& dir, const SuiteResult& result) 
     for (const RunRecord& r : sr.runs) write_series(r, r.engine);
     if (sr.reference.run) write_series(*sr.reference.run, "reference");
   }
-  write_file_atomically(dir / "results.json", suite_to_json(result).dump(2) + "\n");
+  write_results_json(dir / "results.json", result);
+}
+
+namespace {
+
+// results.json streamed: the text suite_to_json(result).dump(2) gives, byte for byte,
+// written piece by piece, so that no JSON tree of every run's contacts and final states
+// exists at once (on a 100k-body gas that tree was several kB a body).
+class JsonStream {
+ public:
+  explicit JsonStream(std::ostream& os) : os_(os) {}
+  // A value at nesting depth `depth` (its first line is already placed).
+  void value(const json& v, int depth) {
+    const std::string text = v.dump(2);
+    const std::string pad(static_cast<std::size_t>(2 * depth), ' ');
+    std::size_t from = 0;
+    for (std::size_t nl = text.find('\n'); nl != std::string::npos; nl = text.find('\n', from)) {
+      os_.write(text.data() + from, static_cast<std::streamsize>(nl + 1 - from));
+      os_ << pad;
+      from = nl + 1;
+    }
+    os_.write(text.data() + from, static_cast<std::streamsize>(text.size() - from));
+  }
+  // An array whose elements come from `element(i)`, at depth `depth`.
+  template <class Element>
+  void array(std::size_t n, int depth, Element element) {
+    if (n == 0) {
+      os_ << "[]";
+      return;
+    }
+    const std::string pad(static_cast<std::size_t>(2 * (depth + 1)), ' ');
+    os_ << "[\n";
+    for (std::size_t i = 0; i < n; ++i) {
+      os_ << pad;
+      element(i, depth + 1);
+      os_ << (i + 1 < n ? ",\n" : "\n");
+    }
+    os_ << std::string(static_cast<std::size_t>(2 * depth), ' ') << ']';
+  }
+  // An object of the keys of `small` and the `big` keys written by their functions, in
+  // nlohmann's (sorted) key order.
+  void object(const json& small, const std::map<std::string, std::function<void(int)>>& big, int depth) {
+    std::vector<std::string> keys;
+    for (const auto& [k, v] : small.items()) keys.push_back(k);
+    for (const auto& [k, f] : big) keys.push_back(k);
+    std::sort(keys.begin(), keys.end());
+    if (keys.empty()) {
+      os_ << "{}";
+      return;
+    }
+    const std::string pad(static_cast<std::size_t>(2 * (depth + 1)), ' ');
+    os_ << "{\n";
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      os_ << pad << json(keys[i]).dump() << ": ";
+      if (auto it = big.find(keys[i]); it != big.end()) {
+        it->second(depth + 1);
+      } else {
+        value(small.at(keys[i]), depth + 1);
+      }
+      os_ << (i + 1 < keys.size() ? ",\n" : "\n");
+    }
+    os_ << std::string(static_cast<std::size_t>(2 * depth), ' ') << '}';
+  }
+
+ private:
+  std::ostream& os_;
+};
+
+}  // namespace
+
+void write_results_json(std::ostream& os, const SuiteResult& result) {
+  JsonStream out(os);
+  std::vector<const RunRecord*> runs;
+  for (const ScenarioResult& sr : result.scenarios) {
+    for (const RunRecord& r : sr.runs) runs.push_back(&r);
+  }
+  // Each run without its two long lists, which are streamed element by element.
+  auto run_json = [&](std::size_t i, int depth) {
+    const RunRecord& r = *runs[i];
+    json small = run_to_json_without_lists(r);
+    std::map<std::string, std::function<void(int)>> big;
+    big["contacts"] = [&](int d) {
+      out.array(r.contacts.size(), d, [&](std::size_t k, int dd) {
+        const ContactRecord& c = r.contacts[k];
+        out.value({{"a", c.a}, {"b", c.b}, {"time", c.time}, {"step", c.step}}, dd);
+      });
+    };
+    big["final"] = [&](int d) {
+      const std::size_t n = std::min(r.final_states.size(), r.bodies.size());
+      out.array(n, d, [&](std::size_t k, int dd) { out.value(final_state_json(r, k), dd); });
+    };
+    out.object(small, big, depth);
+  };
+  json small = suite_to_json_without_lists(result);
+  std::map<std::string, std::function<void(int)>> big;
+  big["runs"] = [&](int d) { out.array(runs.size(), d, run_json); };
+  big["references"] = [&](int d) {
+    out.array(result.scenarios.size(), d, [&](std::size_t s, int dd) {
+      const ScenarioResult& sr = result.scenarios[s];
+      json ref = reference_json_without_contacts(sr);
+      std::map<std::string, std::function<void(int)>> contacts;
+      contacts["contacts"] = [&](int d3) {
+        const std::size_t n = sr.reference.run ? sr.reference.run->contacts.size() : 0;
+        out.array(n, d3, [&](std::size_t k, int d4) {
+          const ContactRecord& c = sr.reference.run->contacts[k];
+          out.value({{"a", c.a}, {"b", c.b}, {"time", c.time}}, d4);
+        });
+      };
+      out.object(ref, contacts, dd);
+    });
+  };
+  out.object(small, big, 0);
+  os << '\n';
+}
+
+void write_results_json(const std::filesystem::path& path, const SuiteResult& result) {
+  // Written beside, then renamed into place, as write_file_atomically does.
+  const std::filesystem::path dir = path.parent_path().empty() ? std::filesystem::path(".") : path.parent_path();
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path tmp = dir / ("." + path.filename().string() + ".tmp." + std::to_string(::getpid()));
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+    write_results_json(out, result);
+    out.flush();
+    if (!out) {
+      std::filesystem::remove(tmp);
+      throw std::runtime_error("cannot write " + tmp.string());
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp);
+    throw std::runtime_error("cannot rename " + tmp.string() + " to " + path.string() + ": " + ec.message());
+  }
 }
 
 }  // namespace physval

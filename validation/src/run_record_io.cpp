@@ -1,140 +1,421 @@
 #include "physval/validation/run_record_io.hpp"
 
-#include <nlohmann/json.hpp>
+#include <poll.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <string>
 
 namespace physval {
 
-using nlohmann::json;
-
 namespace {
 
-json state_to(const BodyState& s) {
-  return json::array({s.position.x, s.position.y, s.velocity.x, s.velocity.y, s.angle, s.angular_velocity, s.alive});
+constexpr std::uint32_t kMagic = 0x70767231;   // "pvr1"
+constexpr std::uint64_t kMaxCount = 1ull << 40;
+
+// --- writing -----------------------------------------------------------------------
+
+template <class Sink>
+class Writer {
+ public:
+  explicit Writer(Sink& sink) : sink_(sink) {}
+  void raw(const void* p, std::size_t n) { sink_.put(p, n); }
+  void u64(std::uint64_t v) { raw(&v, sizeof v); }
+  void i64(std::int64_t v) { raw(&v, sizeof v); }
+  void f64(double v) { raw(&v, sizeof v); }
+  void b(bool v) {
+    const std::uint8_t x = v ? 1 : 0;
+    raw(&x, 1);
+  }
+  void str(const std::string& s) {
+    u64(s.size());
+    raw(s.data(), s.size());
+  }
+  void opt(const std::optional<double>& v) {
+    b(v.has_value());
+    if (v) f64(*v);
+  }
+  void state(const BodyState& s) {
+    const double d[6] = {s.position.x, s.position.y, s.velocity.x, s.velocity.y, s.angle, s.angular_velocity};
+    raw(d, sizeof d);
+    b(s.alive);
+  }
+  void sample(const SampleState& s) {
+    const double d[2] = {s.position.x, s.position.y};
+    raw(d, sizeof d);
+    b(s.alive);
+  }
+
+ private:
+  Sink& sink_;
+};
+
+template <class Sink>
+void write_record(Sink& sink, const RunRecord& r) {
+  Writer<Sink> w(sink);
+  w.u64(kMagic);
+  w.str(r.scenario);
+  w.str(r.engine);
+  w.str(r.engine_version);
+  w.str(r.precision);
+  w.f64(r.dt);
+  w.i64(r.steps);
+  w.i64(r.steps_planned);
+  w.i64(static_cast<std::int64_t>(r.status));
+  w.str(r.reason);
+  w.opt(r.diverged_at);
+  w.f64(r.wall_seconds);
+  w.f64(r.load_seconds);
+  w.u64(r.settings.size());
+  for (const Setting& s : r.settings) {
+    w.str(s.first);
+    w.str(s.second);
+  }
+  w.u64(r.limits_hit.size());
+  for (const std::string& s : r.limits_hit) w.str(s);
+  w.u64(r.bodies.size());
+  for (const BodyMeta& b : r.bodies) {
+    w.str(b.name);
+    w.f64(b.mass);
+    w.f64(b.radius);
+    w.b(b.is_static);
+  }
+  w.u64(r.contacts.size());
+  for (const ContactRecord& c : r.contacts) {
+    w.str(c.a);
+    w.str(c.b);
+    w.f64(c.time);
+    w.i64(c.step);
+  }
+  w.u64(r.probes.size());
+  for (const Probe& p : r.probes) {
+    w.str(p.body);
+    w.f64(p.max_y);
+    w.f64(p.max_y_time);
+    w.f64(p.revolutions);
+    w.f64(p.last_full_rev_time);
+    w.i64(p.full_revolutions);
+  }
+  w.u64(r.series.time.size());
+  for (std::size_t k = 0; k < r.series.time.size(); ++k) {
+    w.f64(r.series.time[k]);
+    const Totals& t = k < r.series.totals.size() ? r.series.totals[k] : Totals{};
+    w.f64(t.kinetic);
+    w.f64(t.potential);
+    w.f64(t.momentum.x);
+    w.f64(t.momentum.y);
+    w.f64(t.angular_momentum);
+    static const SampleRow none;
+    const SampleRow& st = k < r.series.states.size() ? r.series.states[k] : none;
+    w.u64(st.size());
+    for (const SampleState& s : st) w.sample(s);
+  }
+  w.u64(r.final_states.size());
+  for (const BodyState& s : r.final_states) w.state(s);
+  const ContainmentRecord& c = r.containment;
+  w.b(c.measured);
+  w.f64(c.max_penetration);
+  w.opt(c.max_penetration_time);
+  w.str(c.max_penetration_what);
+  w.b(c.escaped_bodies.has_value());
+  w.i64(c.escaped_bodies.value_or(0));
+  w.opt(c.first_escape_time);
+  w.str(c.first_escape);
+  w.u64(kMagic);
 }
-BodyState state_from(const json& j) {
-  BodyState s;
-  s.position = {j.at(0).get<double>(), j.at(1).get<double>()};
-  s.velocity = {j.at(2).get<double>(), j.at(3).get<double>()};
-  s.angle = j.at(4).get<double>();
-  s.angular_velocity = j.at(5).get<double>();
-  s.alive = j.at(6).get<bool>();
-  return s;
+
+struct VectorSink {
+  std::vector<std::uint8_t>& out;
+  void put(const void* p, std::size_t n) {
+    const auto* c = static_cast<const std::uint8_t*>(p);
+    out.insert(out.end(), c, c + n);
+  }
+};
+
+struct FdSink {
+  int fd;
+  bool ok = true;
+  std::vector<std::uint8_t> buffer;
+  std::size_t used = 0;
+  explicit FdSink(int f) : fd(f), buffer(1 << 16) {}
+  void flush() {
+    std::size_t done = 0;
+    while (ok && done < used) {
+      const ssize_t w = ::write(fd, buffer.data() + done, used - done);
+      if (w < 0) {
+        if (errno == EINTR) continue;
+        ok = false;
+        break;
+      }
+      done += static_cast<std::size_t>(w);
+    }
+    used = 0;
+  }
+  void put(const void* p, std::size_t n) {
+    const auto* c = static_cast<const std::uint8_t*>(p);
+    while (n > 0) {
+      if (used == buffer.size()) flush();
+      const std::size_t k = std::min(n, buffer.size() - used);
+      std::memcpy(buffer.data() + used, c, k);
+      used += k;
+      c += k;
+      n -= k;
+    }
+  }
+};
+
+// --- reading -----------------------------------------------------------------------
+
+struct VectorSource {
+  const std::vector<std::uint8_t>& in;
+  std::size_t at = 0;
+  void get(void* p, std::size_t n) {
+    if (n > in.size() - at) throw std::runtime_error("run record: truncated");
+    std::memcpy(p, in.data() + at, n);
+    at += n;
+  }
+};
+
+struct FdSource {
+  int fd;
+  std::optional<std::chrono::steady_clock::time_point> deadline;
+  std::vector<std::uint8_t> buffer = std::vector<std::uint8_t>(1 << 16);
+  std::size_t begin = 0, end = 0, total = 0;
+  void fill() {
+    for (;;) {
+      int wait_ms = -1;
+      if (deadline) {
+        const double left = std::chrono::duration<double>(*deadline - std::chrono::steady_clock::now()).count();
+        if (left <= 0.0) throw RecordTimeout();
+        wait_ms = static_cast<int>(std::ceil(std::min(left, 60.0) * 1000.0));
+      }
+      pollfd p{fd, POLLIN, 0};
+      const int ready = ::poll(&p, 1, wait_ms);
+      if (ready < 0 && errno == EINTR) continue;
+      if (ready == 0) continue;   // re-checks the deadline
+      const ssize_t got = ::read(fd, buffer.data(), buffer.size());
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0) throw std::runtime_error("run record: the stream ended early");
+      begin = 0;
+      end = static_cast<std::size_t>(got);
+      total += end;
+      return;
+    }
+  }
+  void get(void* p, std::size_t n) {
+    auto* c = static_cast<std::uint8_t*>(p);
+    while (n > 0) {
+      if (begin == end) fill();
+      const std::size_t k = std::min(n, end - begin);
+      std::memcpy(c, buffer.data() + begin, k);
+      begin += k;
+      c += k;
+      n -= k;
+    }
+  }
+};
+
+template <class Source>
+class Reader {
+ public:
+  explicit Reader(Source& source) : src_(source) {}
+  std::uint64_t u64() {
+    std::uint64_t v;
+    src_.get(&v, sizeof v);
+    return v;
+  }
+  std::uint64_t count() {
+    const std::uint64_t n = u64();
+    if (n > kMaxCount) throw std::runtime_error("run record: malformed (count " + std::to_string(n) + ")");
+    return n;
+  }
+  std::int64_t i64() {
+    std::int64_t v;
+    src_.get(&v, sizeof v);
+    return v;
+  }
+  double f64() {
+    double v;
+    src_.get(&v, sizeof v);
+    return v;
+  }
+  bool b() {
+    std::uint8_t x;
+    src_.get(&x, 1);
+    if (x > 1) throw std::runtime_error("run record: malformed (flag)");
+    return x == 1;
+  }
+  std::string str() {
+    const std::uint64_t n = count();
+    std::string s;
+    // Read in pieces: a corrupt length cannot allocate more than arrives.
+    while (s.size() < n) {
+      char buf[4096];
+      const std::size_t k = std::min<std::uint64_t>(sizeof buf, n - s.size());
+      src_.get(buf, k);
+      s.append(buf, k);
+    }
+    return s;
+  }
+  std::optional<double> opt() {
+    if (!b()) return std::nullopt;
+    return f64();
+  }
+  BodyState state() {
+    double d[6];
+    src_.get(d, sizeof d);
+    BodyState s;
+    s.position = {d[0], d[1]};
+    s.velocity = {d[2], d[3]};
+    s.angle = d[4];
+    s.angular_velocity = d[5];
+    s.alive = b();
+    return s;
+  }
+  SampleState sample() {
+    double d[2];
+    src_.get(d, sizeof d);
+    SampleState s;
+    s.position = {d[0], d[1]};
+    s.alive = b();
+    return s;
+  }
+
+ private:
+  Source& src_;
+};
+
+// Reserves at most what a sane stream could fill, so a corrupt count fails on reading.
+template <class T>
+void reserve_some(std::vector<T>& v, std::uint64_t n) {
+  v.reserve(static_cast<std::size_t>(std::min<std::uint64_t>(n, 1u << 20)));
 }
-json states_to(const std::vector<BodyState>& v) {
-  json a = json::array();
-  for (const BodyState& s : v) a.push_back(state_to(s));
-  return a;
-}
-std::vector<BodyState> states_from(const json& j) {
-  std::vector<BodyState> v;
-  v.reserve(j.size());
-  for (const json& e : j) v.push_back(state_from(e));
-  return v;
-}
-// NaN and infinity survive CBOR; optional values travel as null.
-json opt(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
-std::optional<double> opt(const json& j) {
-  if (j.is_null()) return std::nullopt;
-  return j.get<double>();
+
+template <class Source>
+RunRecord read_record(Source& source) {
+  Reader<Source> rd(source);
+  if (rd.u64() != kMagic) throw std::runtime_error("run record: not a physval run record");
+  RunRecord r;
+  r.scenario = rd.str();
+  r.engine = rd.str();
+  r.engine_version = rd.str();
+  r.precision = rd.str();
+  r.dt = rd.f64();
+  r.steps = rd.i64();
+  r.steps_planned = rd.i64();
+  const std::int64_t status = rd.i64();
+  if (status < 0 || status > static_cast<std::int64_t>(RunStatus::Error)) throw std::runtime_error("run record: malformed (status)");
+  r.status = static_cast<RunStatus>(status);
+  r.reason = rd.str();
+  r.diverged_at = rd.opt();
+  r.wall_seconds = rd.f64();
+  r.load_seconds = rd.f64();
+  for (std::uint64_t n = rd.count(), i = 0; i < n; ++i) {
+    std::string k = rd.str();
+    r.settings.emplace_back(std::move(k), rd.str());
+  }
+  for (std::uint64_t n = rd.count(), i = 0; i < n; ++i) r.limits_hit.push_back(rd.str());
+  const std::uint64_t nb = rd.count();
+  reserve_some(r.bodies, nb);
+  for (std::uint64_t i = 0; i < nb; ++i) {
+    BodyMeta b;
+    b.name = rd.str();
+    b.mass = rd.f64();
+    b.radius = rd.f64();
+    b.is_static = rd.b();
+    r.bodies.push_back(std::move(b));
+  }
+  const std::uint64_t nc = rd.count();
+  reserve_some(r.contacts, nc);
+  for (std::uint64_t i = 0; i < nc; ++i) {
+    ContactRecord c;
+    c.a = rd.str();
+    c.b = rd.str();
+    c.time = rd.f64();
+    c.step = rd.i64();
+    r.contacts.push_back(std::move(c));
+  }
+  for (std::uint64_t n = rd.count(), i = 0; i < n; ++i) {
+    Probe p;
+    p.body = rd.str();
+    p.max_y = rd.f64();
+    p.max_y_time = rd.f64();
+    p.revolutions = rd.f64();
+    p.last_full_rev_time = rd.f64();
+    p.full_revolutions = static_cast<int>(rd.i64());
+    r.probes.push_back(std::move(p));
+  }
+  const std::uint64_t ns = rd.count();
+  reserve_some(r.series.time, ns);
+  reserve_some(r.series.totals, ns);
+  reserve_some(r.series.states, ns);
+  for (std::uint64_t k = 0; k < ns; ++k) {
+    r.series.time.push_back(rd.f64());
+    Totals t;
+    t.kinetic = rd.f64();
+    t.potential = rd.f64();
+    t.momentum.x = rd.f64();
+    t.momentum.y = rd.f64();
+    t.angular_momentum = rd.f64();
+    r.series.totals.push_back(t);
+    const std::uint64_t n = rd.count();
+    SampleRow st;
+    reserve_some(st, n);
+    for (std::uint64_t i = 0; i < n; ++i) st.push_back(rd.sample());
+    r.series.states.push_back(std::move(st));
+  }
+  const std::uint64_t nf = rd.count();
+  reserve_some(r.final_states, nf);
+  for (std::uint64_t i = 0; i < nf; ++i) r.final_states.push_back(rd.state());
+  ContainmentRecord& c = r.containment;
+  c.measured = rd.b();
+  c.max_penetration = rd.f64();
+  c.max_penetration_time = rd.opt();
+  c.max_penetration_what = rd.str();
+  const bool has_escaped = rd.b();
+  const std::int64_t escaped = rd.i64();
+  if (has_escaped) c.escaped_bodies = static_cast<int>(escaped);
+  c.first_escape_time = rd.opt();
+  c.first_escape = rd.str();
+  if (rd.u64() != kMagic) throw std::runtime_error("run record: malformed (no end mark)");
+  return r;
 }
 
 }  // namespace
 
 std::vector<std::uint8_t> encode_run_record(const RunRecord& r) {
-  json j;
-  j["scenario"] = r.scenario;
-  j["engine"] = r.engine;
-  j["engine_version"] = r.engine_version;
-  j["precision"] = r.precision;
-  j["dt"] = r.dt;
-  j["steps"] = r.steps;
-  j["steps_planned"] = r.steps_planned;
-  j["status"] = static_cast<int>(r.status);
-  j["reason"] = r.reason;
-  j["diverged_at"] = opt(r.diverged_at);
-  j["wall_seconds"] = r.wall_seconds;
-  j["load_seconds"] = r.load_seconds;
-  j["settings"] = r.settings;
-  j["limits_hit"] = r.limits_hit;
-  json bodies = json::array();
-  for (const BodyMeta& b : r.bodies) bodies.push_back(json::array({b.name, b.mass, b.radius, b.is_static}));
-  j["bodies"] = bodies;
-  json contacts = json::array();
-  for (const ContactRecord& c : r.contacts) contacts.push_back(json::array({c.a, c.b, c.time, c.step}));
-  j["contacts"] = contacts;
-  json probes = json::array();
-  for (const Probe& p : r.probes) {
-    probes.push_back(json::array({p.body, p.max_y, p.max_y_time, p.revolutions, p.last_full_rev_time, p.full_revolutions}));
-  }
-  j["probes"] = probes;
-  json time = r.series.time, totals = json::array(), states = json::array();
-  for (const Totals& t : r.series.totals) {
-    totals.push_back(json::array({t.kinetic, t.potential, t.momentum.x, t.momentum.y, t.angular_momentum}));
-  }
-  for (const auto& s : r.series.states) states.push_back(states_to(s));
-  j["series"] = {{"time", time}, {"totals", totals}, {"states", states}};
-  j["final_states"] = states_to(r.final_states);
-  const ContainmentRecord& c = r.containment;
-  j["containment"] = json::array({c.measured, c.max_penetration, opt(c.max_penetration_time), c.max_penetration_what,
-                                  c.escaped_bodies ? json(*c.escaped_bodies) : json(nullptr), opt(c.first_escape_time),
-                                  c.first_escape});
-  return json::to_cbor(j);
+  std::vector<std::uint8_t> bytes;
+  VectorSink sink{bytes};
+  write_record(sink, r);
+  return bytes;
 }
 
 RunRecord decode_run_record(const std::vector<std::uint8_t>& bytes) {
-  const json j = json::from_cbor(bytes);
-  RunRecord r;
-  r.scenario = j.at("scenario").get<std::string>();
-  r.engine = j.at("engine").get<std::string>();
-  r.engine_version = j.at("engine_version").get<std::string>();
-  r.precision = j.at("precision").get<std::string>();
-  r.dt = j.at("dt").get<double>();
-  r.steps = j.at("steps").get<long>();
-  r.steps_planned = j.at("steps_planned").get<long>();
-  r.status = static_cast<RunStatus>(j.at("status").get<int>());
-  r.reason = j.at("reason").get<std::string>();
-  r.diverged_at = opt(j.at("diverged_at"));
-  r.wall_seconds = j.at("wall_seconds").get<double>();
-  r.load_seconds = j.at("load_seconds").get<double>();
-  r.settings = j.at("settings").get<std::vector<Setting>>();
-  r.limits_hit = j.at("limits_hit").get<std::vector<std::string>>();
-  for (const json& b : j.at("bodies")) {
-    r.bodies.push_back({b.at(0).get<std::string>(), b.at(1).get<double>(), b.at(2).get<double>(), b.at(3).get<bool>()});
-  }
-  for (const json& c : j.at("contacts")) {
-    r.contacts.push_back({c.at(0).get<std::string>(), c.at(1).get<std::string>(), c.at(2).get<double>(), c.at(3).get<long>()});
-  }
-  for (const json& p : j.at("probes")) {
-    Probe pr;
-    pr.body = p.at(0).get<std::string>();
-    pr.max_y = p.at(1).get<double>();
-    pr.max_y_time = p.at(2).get<double>();
-    pr.revolutions = p.at(3).get<double>();
-    pr.last_full_rev_time = p.at(4).get<double>();
-    pr.full_revolutions = p.at(5).get<int>();
-    r.probes.push_back(pr);
-  }
-  const json& s = j.at("series");
-  r.series.time = s.at("time").get<std::vector<double>>();
-  for (const json& t : s.at("totals")) {
-    Totals x;
-    x.kinetic = t.at(0).get<double>();
-    x.potential = t.at(1).get<double>();
-    x.momentum = {t.at(2).get<double>(), t.at(3).get<double>()};
-    x.angular_momentum = t.at(4).get<double>();
-    r.series.totals.push_back(x);
-  }
-  for (const json& st : s.at("states")) r.series.states.push_back(states_from(st));
-  r.final_states = states_from(j.at("final_states"));
-  const json& c = j.at("containment");
-  r.containment.measured = c.at(0).get<bool>();
-  r.containment.max_penetration = c.at(1).get<double>();
-  r.containment.max_penetration_time = opt(c.at(2));
-  r.containment.max_penetration_what = c.at(3).get<std::string>();
-  if (!c.at(4).is_null()) r.containment.escaped_bodies = c.at(4).get<int>();
-  r.containment.first_escape_time = opt(c.at(5));
-  r.containment.first_escape = c.at(6).get<std::string>();
+  VectorSource source{bytes};
+  RunRecord r = read_record(source);
+  if (source.at != bytes.size()) throw std::runtime_error("run record: trailing bytes");
   return r;
+}
+
+bool write_run_record(int fd, const RunRecord& r) {
+  FdSink sink(fd);
+  write_record(sink, r);
+  sink.flush();
+  return sink.ok;
+}
+
+RunRecord read_run_record(int fd, std::optional<std::chrono::steady_clock::time_point> deadline, std::size_t& bytes_read) {
+  FdSource source{fd, deadline};
+  try {
+    RunRecord r = read_record(source);
+    bytes_read = source.total;
+    return r;
+  } catch (...) {
+    bytes_read = source.total;
+    throw;
+  }
 }
 
 }  // namespace physval

@@ -264,19 +264,6 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
 
 namespace {
 
-bool write_all(int fd, const std::uint8_t* data, std::size_t size) {
-  while (size > 0) {
-    const ssize_t w = ::write(fd, data, size);
-    if (w < 0) {
-      if (errno == EINTR) continue;
-      return false;
-    }
-    data += w;
-    size -= static_cast<std::size_t>(w);
-  }
-  return true;
-}
-
 // --- Child processes die with their parent -----------------------------------------
 // Two mechanisms, because neither covers every way a parent ends:
 //  - SIGKILL of the parent (nothing of it runs): the kernel sends the child
@@ -347,7 +334,11 @@ std::string seconds_text(double seconds) {
 
 }  // namespace
 
-RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, const RunOptions& options) {
+namespace {
+
+// `owned`: the caller's scene, released in the parent as soon as the child has its copy
+// (a large scene's copy need not live while the record comes back).
+RunRecord run_isolated(const Scene& scene, const EngineFactory& factory, const RunOptions& options, Scene* owned) {
   if (!options.isolate) return run_engine(scene, factory, options);
   int fds[2];
   if (::pipe(fds) != 0) return run_engine(scene, factory, options);
@@ -367,8 +358,7 @@ RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, 
     int code = 0;
     try {
       const RunRecord r = run_engine(scene, factory, options);
-      const std::vector<std::uint8_t> bytes = encode_run_record(r);
-      if (!write_all(fds[1], bytes.data(), bytes.size())) code = 3;
+      if (!write_run_record(fds[1], r)) code = 3;   // streamed: no second copy of the series
     } catch (...) {
       code = 4;
     }
@@ -377,32 +367,34 @@ RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, 
   }
   remember_live_child(pid);
   ::close(fds[1]);
-  std::vector<std::uint8_t> bytes;
-  std::uint8_t buffer[1 << 16];
-  const auto start = std::chrono::steady_clock::now();
+  RunRecord fallback = blank_record(scene, factory.info);
+  fallback.status = RunStatus::Error;
+  if (owned != nullptr) *owned = Scene{};   // `scene` is not read again below
+  // The record is read straight from the pipe into a RunRecord as it arrives.
+  std::optional<std::chrono::steady_clock::time_point> deadline;
+  if (options.timeout_seconds > 0.0) {
+    deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                      std::chrono::duration<double>(options.timeout_seconds));
+  }
+  if (options.deadline) deadline = deadline ? std::min(*deadline, *options.deadline) : *options.deadline;
   bool timed_out = false;
-  for (;;) {
-    int wait_ms = -1;
-    if (options.timeout_seconds > 0.0 || options.deadline) {
-      const auto now = std::chrono::steady_clock::now();
-      double left = options.timeout_seconds > 0.0
-                        ? options.timeout_seconds - std::chrono::duration<double>(now - start).count()
-                        : 1e300;
-      if (options.deadline) left = std::min(left, std::chrono::duration<double>(*options.deadline - now).count());
-      if (left <= 0.0) {
-        timed_out = true;
-        break;
-      }
-      wait_ms = static_cast<int>(std::ceil(std::min(left, 60.0) * 1000.0));
+  std::optional<RunRecord> record;
+  std::string read_error;
+  std::size_t bytes_read = 0;
+  try {
+    record = read_run_record(fds[0], deadline, bytes_read);
+  } catch (const RecordTimeout&) {
+    timed_out = true;
+  } catch (const std::exception& e) {
+    read_error = e.what();
+    // Whatever else the child writes is drained, so it is never left blocked on a full pipe.
+    std::uint8_t sink[1 << 12];
+    for (;;) {
+      const ssize_t got = ::read(fds[0], sink, sizeof sink);
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0) break;
+      bytes_read += static_cast<std::size_t>(got);
     }
-    pollfd p{fds[0], POLLIN, 0};
-    const int ready = ::poll(&p, 1, wait_ms);
-    if (ready < 0 && errno == EINTR) continue;
-    if (ready == 0) continue;   // loop re-checks the deadline
-    const ssize_t got = ::read(fds[0], buffer, sizeof buffer);
-    if (got < 0 && errno == EINTR) continue;
-    if (got <= 0) break;
-    bytes.insert(bytes.end(), buffer, buffer + got);
   }
   ::close(fds[0]);
   if (timed_out) ::kill(pid, SIGKILL);
@@ -410,8 +402,6 @@ RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, 
   int wstatus = 0;
   while (::waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
   }
-  RunRecord fallback = blank_record(scene, factory.info);
-  fallback.status = RunStatus::Error;
   if (timed_out) {
     fallback.reason = "timed out after " + seconds_text(options.timeout_seconds) + " s";
     return fallback;
@@ -421,16 +411,25 @@ RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, 
     fallback.reason = std::string("engine crashed: signal ") + std::to_string(sig) + " (" + strsignal(sig) + ")";
     return fallback;
   }
-  if (!WIFEXITED(wstatus) || WEXITSTATUS(wstatus) != 0 || bytes.empty()) {
+  if (!WIFEXITED(wstatus) || WEXITSTATUS(wstatus) != 0 || bytes_read == 0) {
     fallback.reason = "engine process exited with status " + std::to_string(WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1);
     return fallback;
   }
-  try {
-    return decode_run_record(bytes);
-  } catch (const std::exception& e) {
-    fallback.reason = std::string("could not read the engine process's result: ") + e.what();
+  if (!record) {
+    fallback.reason = "could not read the engine process's result: " + read_error;
     return fallback;
   }
+  return std::move(*record);
+}
+
+}  // namespace
+
+RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, const RunOptions& options) {
+  return run_isolated(scene, factory, options, nullptr);
+}
+
+RunRecord run_engine_isolated(Scene&& scene, const EngineFactory& factory, const RunOptions& options) {
+  return run_isolated(scene, factory, options, &scene);
 }
 
 }  // namespace physval

@@ -26,7 +26,7 @@ std::string seconds_text(double seconds) {
 
 }  // namespace
 
-SuiteResult run_suite(const std::vector<Scene>& scenes, const std::vector<std::string>& engines,
+SuiteResult run_suite(std::vector<Scene> scenes, const std::vector<std::string>& engines,
                       const RunOptions& options, bool enforce_gates, const Progress& progress, std::size_t jobs) {
   SuiteResult result;
   result.gates_enforced = enforce_gates;
@@ -45,7 +45,9 @@ SuiteResult run_suite(const std::vector<Scene>& scenes, const std::vector<std::s
   result.scenarios.resize(scenes.size());
   for (std::size_t s = 0; s < scenes.size(); ++s) {
     ScenarioResult& sr = result.scenarios[s];
-    sr.scene = effective_scene(scenes[s], options);
+    sr.scene = std::move(scenes[s]);   // effective_scene() in place, without a copy
+    if (options.dt) sr.scene.dt = *options.dt;
+    if (options.duration) sr.scene.duration = *options.duration;
     const double cost = estimated_cost(sr.scene);
     tasks.push_back({s, nullptr, 0});
     costs.push_back(12.0 * cost);

@@ -16,6 +16,7 @@
 #include "physval/validation/reference_cache.hpp"
 #include "physval/validation/runner.hpp"
 #include "physval/validation/scheduler.hpp"
+#include "physval/validation/shard.hpp"
 
 namespace physval {
 
@@ -136,6 +137,13 @@ void time_point(SweepPoint& p, const Scene& scene, const EngineFactory& engine, 
 }
 
 }  // namespace
+
+std::string sweep_spread_note(const std::vector<SweepPoint>& points, double threshold) {
+  const auto wide = std::count_if(points.begin(), points.end(), [](const SweepPoint& p) { return p.spread_warning; });
+  if (wide == 0) return "";
+  return std::to_string(wide) + " point(s) timed with a spread above " + std::to_string(static_cast<int>(threshold * 100)) +
+         "% (marked !): a busy machine; rerun with more --repetitions";
+}
 
 std::vector<SweepVariant> sweep_variants(const EngineInfo& info, const Scene& scene, bool settings) {
   const std::vector<Axis> axes = settings ? sweep_axes(info, scene) : std::vector<Axis>{};
@@ -269,9 +277,39 @@ SweepResult run_sweep(const Scene& scene, const SweepOptions& options, const Pro
       }
     }
   }
-  std::vector<SweepPoint> points(work.size());
   std::vector<double> costs;
   for (const Work& w : work) costs.push_back(static_cast<double>(w.scene.steps()));
+  std::vector<std::size_t> global_index(work.size());
+  for (std::size_t i = 0; i < work.size(); ++i) global_index[i] = i;
+  if (options.shard_count > 1) {
+    // The points split by cost: steps times bodies (every point runs the same scene), so
+    // step counts decide, and the timing runs (a fixed minimum each) roughly follow.
+    const double bodies = static_cast<double>(std::max<std::size_t>(1, sampled.bodies.size()));
+    std::vector<double> shard_costs;
+    for (double c : costs) shard_costs.push_back(c * bodies);
+    const std::vector<std::size_t> assigned = assign_shards(shard_costs, options.shard_count);
+    nlohmann::json all = nlohmann::json::array(), mine = nlohmann::json::array();
+    std::vector<Work> kept;
+    std::vector<double> kept_costs;
+    std::vector<std::size_t> kept_index;
+    for (std::size_t i = 0; i < work.size(); ++i) {
+      all.push_back({{"engine", work[i].engine->info.name}, {"setting", work[i].variant->label}, {"dt", work[i].dt},
+                     {"shard", assigned[i]}});
+      if (assigned[i] != options.shard_index) continue;
+      kept.push_back(std::move(work[i]));
+      kept_costs.push_back(costs[i]);
+      kept_index.push_back(i);
+    }
+    work = std::move(kept);
+    costs = std::move(kept_costs);
+    global_index = std::move(kept_index);
+    result.shard = {{"index", options.shard_index},
+                    {"count", options.shard_count},
+                    {"points", all},
+                    {"spread_warning", options.spread_warning},
+                    {"mine", nlohmann::json::array()}};
+  }
+  std::vector<SweepPoint> points(work.size());
   std::mutex say_mutex;
   run_tasks(costs, std::max<std::size_t>(1, options.jobs), [&](std::size_t i) {
     const Work& w = work[i];
@@ -324,15 +362,17 @@ SweepResult run_sweep(const Scene& scene, const SweepOptions& options, const Pro
       if (p.spread_warning) line += " (timing spread " + std::to_string(static_cast<int>(p.spread * 100)) + "%)";
     }
     say(line);
+    if (!result.shard.is_null()) {
+      nlohmann::json settings = nlohmann::json::array();   // in the engine's order
+      for (const auto& [key, value] : p.engine_settings) settings.push_back({key, value});
+      result.shard["mine"].push_back({{"index", global_index[i]}, {"engine_settings", settings}});
+    }
     result.points.push_back(std::move(p));
   }
 
-  const auto wide = std::count_if(result.points.begin(), result.points.end(),
-                                  [](const SweepPoint& p) { return p.spread_warning; });
-  if (wide > 0) {
-    result.notes.push_back(std::to_string(wide) + " point(s) timed with a spread above " +
-                           std::to_string(static_cast<int>(options.spread_warning * 100)) +
-                           "% (marked !): a busy machine; rerun with more --repetitions");
+  if (!result.shard.is_null()) result.shard["notes"] = result.notes;   // the notes before the timing's own
+  if (std::string note = sweep_spread_note(result.points, options.spread_warning); !note.empty()) {
+    result.notes.push_back(std::move(note));
   }
   analyse_sweep(result);
   return result;

@@ -490,6 +490,7 @@ nlohmann::json sweep_to_json(const SweepResult& r) {
   }
   j["orders"] = std::move(orders);
   j["notes"] = r.notes;
+  if (!r.shard.is_null()) j["shard"] = r.shard;
   return j;
 }
 

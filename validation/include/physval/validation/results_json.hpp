@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <ostream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -18,6 +19,11 @@ nlohmann::json suite_to_json(const SuiteResult& result);
 // every body's name, radius, mass and whether it is static, and the barriers (walls
 // from/to, boxes min/max, surfaces' points), in scene coordinates (m).
 nlohmann::json scene_geometry_json(const ScenarioResult& result);
+
+// The text suite_to_json(result).dump(2) + "\n", streamed run by run and contact by
+// contact (no tree of the whole file in memory); the file version writes atomically.
+void write_results_json(std::ostream& os, const SuiteResult& result);
+void write_results_json(const std::filesystem::path& path, const SuiteResult& result);
 
 // Writes text to path whole or not at all (temporary file in the same folder, then
 // rename). Creates the folder. Throws std::runtime_error on failure.

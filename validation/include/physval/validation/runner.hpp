@@ -22,7 +22,7 @@ struct RunOptions {
   // isolated run stops at the earlier of its timeout and this deadline.
   std::optional<std::chrono::steady_clock::time_point> deadline;
   // Bound on stored samples x bodies (memory); the sample interval grows to fit.
-  std::size_t max_sample_states = 4'000'000;
+  std::size_t max_sample_states = 1'000'000;
   // Folder of the reference cache (see reference_cache.hpp); empty: no cache.
   std::string reference_cache;
 };
@@ -40,6 +40,9 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& engine, const RunO
 
 // The same in a child process (when options.isolate), surviving crashes and hangs.
 RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& engine, const RunOptions& options);
+// The same for a scene the caller gives away (a variant made for this run): the parent
+// releases it once the child has forked, before the record comes back.
+RunRecord run_engine_isolated(Scene&& scene, const EngineFactory& factory, const RunOptions& options);
 
 // A run that never happened because the engine cannot model the scene.
 RunRecord unsupported_run(const Scene& scene, const EngineInfo& info, const std::vector<std::string>& missing);

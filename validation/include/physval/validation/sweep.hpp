@@ -34,6 +34,10 @@ struct SweepOptions {
                                       // point that times out is an error, not timed.
   std::string reference_cache;        // reference cache folder (reference_cache.hpp); empty: none
   std::size_t jobs = 1;               // error runs at once; timing runs always one at a time
+  // `--shard I/N`: only the points the split (shard.hpp) gives part I of N. Every shard
+  // builds the same reference (from the cache when the shards share one).
+  std::size_t shard_index = 0;
+  std::size_t shard_count = 1;
 };
 
 // One engine configuration of the sweep: option overrides for the engine's table.
@@ -107,11 +111,18 @@ struct SweepResult {
   std::vector<SweepPoint> points;     // engine, then setting, then dt (coarse to fine)
   std::vector<ConvergenceOrder> orders;   // one per engine and setting, in point order
   std::vector<std::string> notes;     // engines left out and why, timing warnings
+  // A shard's sweep.json "shard" block: every point of the whole sweep with its shard,
+  // and this shard's points' indices in it (`physval merge` puts them back in order);
+  // null for a whole sweep.
+  nlohmann::json shard;
 };
 
 // Runs the sweep. Engines that cannot model the scene are left out with a note.
 // Never throws for an engine's failure: the point records status and reason.
 SweepResult run_sweep(const Scene& scene, const SweepOptions& options, const Progress& progress = {});
+
+// The note on points timed with a spread above `threshold`; "" when there are none.
+std::string sweep_spread_note(const std::vector<SweepPoint>& points, double threshold);
 
 // Fills result.orders and each point's pareto flag from the points (run_sweep calls it).
 void analyse_sweep(SweepResult& result);
