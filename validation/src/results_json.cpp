@@ -11,6 +11,7 @@
 #include <fstream>
 #include <iomanip>
 #include <sstream>
+#include <unordered_set>
 #include <stdexcept>
 
 #include "physval/adapters/registry.hpp"
@@ -239,35 +240,62 @@ void StagedOutputFolder::commit() {
   if (had_old) fs::remove_all(old, ec);
 }
 
-json scene_geometry_json(const ScenarioResult& sr) {
+namespace {
+
+// series/<scenario>/scene.json, streamed: on a 100k-body scene a JSON tree of the bodies
+// (and a linear search for duplicates) cost more than the harness's whole budget per body.
+void write_scene_geometry(std::ostream& os, const ScenarioResult& sr) {
+  auto text = [](const std::string& v) { return json(v).dump(); };
+  auto number = [](double v) { return json(v).dump(); };
+  auto point = [&](Vec2 p) { return "[" + number(p.x) + ", " + number(p.y) + "]"; };
+  os << "{\n \"scenario\": " << text(sr.scene.name) << ",\n \"duration\": " << number(sr.scene.duration)
+     << ",\n \"dt\": " << number(sr.scene.dt) << ",\n \"bodies\": [";
   // Every body any run had (particles appear in the runs only), in first-seen order.
-  json bodies = json::array();
-  std::vector<std::string> seen;
+  std::unordered_set<std::string> seen;
+  bool first = true;
+  auto body = [&](const std::string& name, double radius, double mass, bool is_static) {
+    if (!seen.insert(name).second) return;
+    os << (first ? "\n  " : ",\n  ") << "{\"name\": " << text(name) << ", \"radius\": " << number(radius)
+       << ", \"mass\": " << number(mass) << ", \"static\": " << (is_static ? "true" : "false") << "}";
+    first = false;
+  };
   auto add_bodies = [&](const RunRecord& r) {
-    for (const BodyMeta& b : r.bodies) {
-      if (std::find(seen.begin(), seen.end(), b.name) != seen.end()) continue;
-      seen.push_back(b.name);
-      bodies.push_back({{"name", b.name}, {"radius", b.radius}, {"mass", b.mass}, {"static", b.is_static}});
-    }
+    for (const BodyMeta& b : r.bodies) body(b.name, b.radius, b.mass, b.is_static);
   };
   if (sr.reference.run) add_bodies(*sr.reference.run);
   for (const RunRecord& r : sr.runs) add_bodies(r);
-  for (const BodyDef& b : sr.scene.bodies) {   // a scene no engine ran
-    if (std::find(seen.begin(), seen.end(), b.name) != seen.end()) continue;
-    seen.push_back(b.name);
-    bodies.push_back({{"name", b.name}, {"radius", b.radius}, {"mass", b.mass}, {"static", b.is_static}});
+  for (const BodyDef& b : sr.scene.bodies) body(b.name, b.radius, b.mass, b.is_static);   // a scene no engine ran
+  os << "\n ],\n \"walls\": [";
+  first = true;
+  for (const WallDef& w : sr.scene.walls) {
+    os << (first ? "\n  " : ",\n  ") << "{\"name\": " << text(w.name) << ", \"from\": " << point(w.from)
+       << ", \"to\": " << point(w.to) << "}";
+    first = false;
   }
-  json walls = json::array(), boxes = json::array(), surfaces = json::array();
-  for (const WallDef& w : sr.scene.walls) walls.push_back({{"name", w.name}, {"from", vec(w.from)}, {"to", vec(w.to)}});
-  for (const BoxDef& b : sr.scene.boxes) boxes.push_back({{"name", b.name}, {"min", vec(b.min)}, {"max", vec(b.max)}});
-  for (const SurfaceDef& s : sr.scene.surfaces) {
-    json points = json::array();
-    for (Vec2 p : s.points) points.push_back(vec(p));
-    surfaces.push_back({{"name", s.name}, {"points", points}});
+  os << "\n ],\n \"boxes\": [";
+  first = true;
+  for (const BoxDef& b : sr.scene.boxes) {
+    os << (first ? "\n  " : ",\n  ") << "{\"name\": " << text(b.name) << ", \"min\": " << point(b.min)
+       << ", \"max\": " << point(b.max) << "}";
+    first = false;
   }
-  return {{"scenario", sr.scene.name}, {"duration", sr.scene.duration}, {"dt", sr.scene.dt},
-          {"bodies", bodies},          {"walls", walls},                 {"boxes", boxes},
-          {"surfaces", surfaces}};
+  os << "\n ],\n \"surfaces\": [";
+  first = true;
+  for (const SurfaceDef& f : sr.scene.surfaces) {
+    os << (first ? "\n  " : ",\n  ") << "{\"name\": " << text(f.name) << ", \"points\": [";
+    for (std::size_t k = 0; k < f.points.size(); ++k) os << (k ? ", " : "") << point(f.points[k]);
+    os << "]}";
+    first = false;
+  }
+  os << "\n ]\n}\n";
+}
+
+}  // namespace
+
+json scene_geometry_json(const ScenarioResult& sr) {
+  std::ostringstream os;
+  write_scene_geometry(os, sr);
+  return json::parse(os.str());
 }
 
 void write_results(const std::filesystem::path& dir, const SuiteResult& result) {
@@ -275,8 +303,11 @@ void write_results(const std::filesystem::path& dir, const SuiteResult& result) 
   // report's scene player draws every body, so the series hold up to this many.
   constexpr std::size_t kMaxBodiesInSeries = 400;
   for (const ScenarioResult& sr : result.scenarios) {
-    write_file_atomically(dir / "series" / safe_file_name(sr.scene.name) / "scene.json",
-                          scene_geometry_json(sr).dump(1) + "\n");
+    {
+      std::ostringstream geometry;
+      write_scene_geometry(geometry, sr);
+      write_file_atomically(dir / "series" / safe_file_name(sr.scene.name) / "scene.json", geometry.str());
+    }
     auto write_series = [&](const RunRecord& r, const std::string& label) {
       if (r.series.time.empty()) return;
       std::ostringstream os;
