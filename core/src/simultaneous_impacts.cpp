@@ -140,6 +140,16 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     c.target = std::max(-e * wn, 0.0);
     const bool seed = face_seed ? (c.a == j0 && c.b == i0) : (c.a == std::min(i0, j0) && c.b == std::max(i0, j0));
     if (seed) c.target = std::max(c.target, seed_min_sep);
+    // A micro-bounce seed (pressed together, too slow to bounce clear): every other pair
+    // of the set that is so too takes the same rule, its own minimum separation, so
+    // that which of two mirror-image pairs was found first (the numbering) does not matter.
+    if (seed_min_sep > 0.0 && !(c.a & kSegmentContact) && w.any_forces) {
+      const double an = dot(w.effective_acc(c.b) - w.effective_acc(c.a), c.n);
+      if (an < 0.0) {
+        const double vr = w.rest_speed(an, w.step_dt);
+        if (e * std::max(0.0, -wn) < vr) c.target = std::max(c.target, 0.5 * vr);
+      }
+    }
     contacts.push_back(c);
   };
   // Adds contact (i, j) if the two touch; false if the set must go pair by pair.
@@ -343,14 +353,67 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   // would crawl when masses differ by 1e9 (its rate is 1 - m_light / m_heavy).
   bool solved = false;
   if (R == K && K <= 6) solved = solve_exactly(rows, contacts, w0, p, inv);
-  // Projected Gauss-Seidel to round-off: normal impulses >= 0 reaching their targets,
-  // tangential ones stopping the sliding within the static friction bound mu_s p_n.
-  // With friction the sweeps can trade round-off for ever: at most 2000 of them then.
+  // Without friction: projected Gauss-Seidel to round-off (the problem has one solution,
+  // so the order of the sweep does not matter beyond round-off).
+  // With friction the solutions can form a family (a ball wedged on two that slide: how
+  // the wedge shares its weight is free), and Gauss-Seidel picks one by the order of
+  // its rows, i.e. by the body numbering. So friction sets are solved by projected
+  // Jacobi: every row is updated from the same velocities, with its step divided by the
+  // number of rows on its busiest body (mass splitting, which keeps the sweep stable),
+  // and tangential impulses kept within mu_s p_n. Renumbering the bodies permutes the
+  // rows and nothing else, and a mirrored scene gives the mirrored iterates.
   const bool friction = R > K;
-  const int max_iter = friction ? 2000 : 100000;
+  const int max_iter = friction ? 20000 : 100000;
   const double stop = 4.0 * kEps;
   double pmax = 0.0;
-  for (int iter = 0; iter < max_iter && !solved; ++iter) {
+  thread_local std::vector<double> omega, pnew;
+  thread_local std::vector<std::int32_t> rows_on;
+  if (friction) {
+    rows_on.assign(bodies.size(), 0);
+    for (std::size_t k = 0; k < R; ++k) {
+      if (slot_a[k] >= 0) ++rows_on[static_cast<std::size_t>(slot_a[k])];
+      if (slot_b[k] >= 0) ++rows_on[static_cast<std::size_t>(slot_b[k])];
+    }
+    omega.assign(R, 1.0);
+    for (std::size_t k = 0; k < R; ++k) {
+      std::int32_t n = 1;
+      if (slot_a[k] >= 0) n = std::max(n, rows_on[static_cast<std::size_t>(slot_a[k])]);
+      if (slot_b[k] >= 0) n = std::max(n, rows_on[static_cast<std::size_t>(slot_b[k])]);
+      omega[k] = 1.0 / static_cast<double>(n);
+    }
+    pnew.assign(R, 0.0);
+  }
+  for (int iter = 0; iter < max_iter && !solved && friction; ++iter) {
+    double change = 0.0;
+    for (std::size_t k = 0; k < R; ++k) {
+      pnew[k] = p[k];
+      const double akk = A[k];
+      if (!(akk > 0.0)) continue;
+      const Row& rk = rows[k];
+      const Vec2 da = slot_a[k] >= 0 ? dv[static_cast<std::size_t>(slot_a[k])] : Vec2{};
+      const Vec2 db = slot_b[k] >= 0 ? dv[static_cast<std::size_t>(slot_b[k])] : Vec2{};
+      const double wk = w0[k] + dot(db - da, rk.d);
+      if (rk.tangent) {
+        const double bound = contacts[rk.contact].mu_s * p[k - 1];
+        pnew[k] = std::clamp(p[k] - omega[k] * wk / akk, -bound, bound);
+      } else {
+        pnew[k] = std::max(0.0, p[k] + omega[k] * (contacts[rk.contact].target - wk) / akk);
+      }
+    }
+    for (std::size_t k = 0; k < R; ++k) {
+      const Row& rk = rows[k];
+      const double dp = pnew[k] - p[k];
+      if (dp != 0.0) {
+        if (slot_a[k] >= 0) dv[static_cast<std::size_t>(slot_a[k])] -= (dp * inv(rk.a)) * rk.d;
+        if (slot_b[k] >= 0) dv[static_cast<std::size_t>(slot_b[k])] += (dp * inv(rk.b)) * rk.d;
+      }
+      change = std::max(change, std::fabs(dp));
+      p[k] = pnew[k];
+      pmax = std::max(pmax, std::fabs(p[k]));
+    }
+    if (change <= stop * pmax) break;
+  }
+  for (int iter = 0; iter < max_iter && !solved && !friction; ++iter) {
     double change = 0.0;
     for (std::size_t k = 0; k < R; ++k) {
       const double akk = A[k];
@@ -359,13 +422,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       const Vec2 da = slot_a[k] >= 0 ? dv[static_cast<std::size_t>(slot_a[k])] : Vec2{};
       const Vec2 db = slot_b[k] >= 0 ? dv[static_cast<std::size_t>(slot_b[k])] : Vec2{};
       const double wk = w0[k] + dot(db - da, rk.d);
-      double pk;
-      if (rk.tangent) {
-        const double bound = contacts[rk.contact].mu_s * p[k - 1];
-        pk = std::clamp(p[k] - wk / akk, -bound, bound);
-      } else {
-        pk = std::max(0.0, p[k] + (contacts[rk.contact].target - wk) / akk);
-      }
+      const double pk = std::max(0.0, p[k] + (contacts[rk.contact].target - wk) / akk);
       const double dp = pk - p[k];
       if (dp != 0.0) {
         if (slot_a[k] >= 0) dv[static_cast<std::size_t>(slot_a[k])] -= (dp * inv(rk.a)) * rk.d;
