@@ -21,23 +21,10 @@ using physval_test::physval;
 
 bool has(const Result& r, const std::string& text) { return r.output.find(text) != std::string::npos; }
 
-class Verdict : public ::testing::Test {
+class Verdict : public physval_test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("physval_verdict_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path write(const std::string& name, const std::string& text) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p;
-  }
+  Verdict() : TempDirTest("physval_verdict_") {}
   std::string out() const { return " --quiet --out " + (dir_ / "out").string(); }
-  fs::path dir_;
 };
 
 // One ball falling onto the floor, on core only; the gate is whatever the test appends.
