@@ -320,13 +320,31 @@ class EventLoop {
     w_.bp->query_box(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), i, near_);
     if (try_hold(w_, i, ctx_.dt, near_, true)) return true;
     const double t = w_.tloc[i];
-    if (!try_hold_group(w_, i, t, ctx_.dt, [this](Vec2 q, double h, std::vector<std::uint32_t>& out) {
-          out.clear();
-          w_.bp->query_box(make_aabb(q.x - h, q.y - h, q.x + h, q.y + h), kNone, out);
-        }, group_)) {
+    const NearFn near = [this](Vec2 q, double h, std::vector<std::uint32_t>& out) {
+      out.clear();
+      w_.bp->query_box(make_aabb(q.x - h, q.y - h, q.x + h, q.y + h), kNone, out);
+    };
+    if (!try_hold_group(w_, i, t, ctx_.dt, near, group_) && !try_hold_group_pocket(w_, i, t, ctx_.dt, near, group_)) {
       return false;
     }
     // The other members' paths changed too (now at rest): new versions, no events.
+    for (std::uint32_t m : group_) {
+      if (m == i) continue;
+      ++w_.version[m];
+      reschedule(m, t);
+    }
+    return true;
+  }
+  // i, slow and free, pressed onto a slow free body: the pocket of the group they form
+  // with the slow bodies near them (try_hold_group_pocket), others rescheduled.
+  bool hold_pocket(std::uint32_t i) {
+    if (w_.stationary(i) || w_.supported(i)) return false;
+    const double t = w_.tloc[i];
+    const NearFn near = [this](Vec2 q, double h, std::vector<std::uint32_t>& out) {
+      out.clear();
+      w_.bp->query_box(make_aabb(q.x - h, q.y - h, q.x + h, q.y + h), kNone, out);
+    };
+    if (!try_hold_group_pocket(w_, i, t, ctx_.dt, near, group_)) return false;
     for (std::uint32_t m : group_) {
       if (m == i) continue;
       ++w_.version[m];
@@ -434,6 +452,8 @@ class EventLoop {
             settled = true;
           } else if (hold_against(i, j) || hold_against(j, i)) {
             settled = true;   // at rest on several supports
+          } else if (hold_pocket(i) || hold_pocket(j)) {
+            settled = true;   // a group micro-bouncing on its supports: its pocket
           } else {
             min_sep = 0.5 * vr;
           }

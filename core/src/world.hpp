@@ -352,6 +352,17 @@ bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_
 using NearFn = std::function<void(Vec2, double, std::vector<std::uint32_t>&)>;
 bool try_hold_group(World& w, std::uint32_t seed, double t, double dt, const NearFn& near_fn,
                     std::vector<std::uint32_t>& members);
+// A group's pocket (the limit of its inelastic collapse): the slow free bodies within
+// rest_speed x dt of the seed (and of each other), with their faces and stationary
+// bodies that near, moved (each at most rest_speed x dt, by the smallest mass-weighted
+// displacement) to where all those near contacts touch, then held there by
+// try_hold_group. Only when that gains no energy (the work of their forces along the
+// move is at least minus their kinetic energy), overlaps nothing and holds them all;
+// otherwise nothing changes (but the members' advance to t along their paths).
+// near_fn(p, pad, out): every body (stationary or not) whose box meets the square of
+// half-side pad around p.
+bool try_hold_group_pocket(World& w, std::uint32_t seed, double t, double dt, const NearFn& near_fn,
+                           std::vector<std::uint32_t>& members);
 // A slow body wedged among stationary bodies and faces (no impulse moves it, so the
 // same impact would recur at the same instant for ever) is held where it is, whether
 // or not its contacts balance its force exactly; the next step judges it again.
