@@ -371,6 +371,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   if (friction) {
     rows_on.assign(bodies.size(), 0);
     for (std::size_t k = 0; k < R; ++k) {
+      if (rows[k].tangent) continue;   // a contact's own two rows are orthogonal: count it once
       if (slot_a[k] >= 0) ++rows_on[static_cast<std::size_t>(slot_a[k])];
       if (slot_b[k] >= 0) ++rows_on[static_cast<std::size_t>(slot_b[k])];
     }
@@ -383,6 +384,17 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     }
     pnew.assign(R, 0.0);
   }
+  // Per row, what the sweeps read (the same numbers, looked up once): its bodies'
+  // inverse masses and its target (normal rows) or friction coefficient (tangent rows).
+  thread_local std::vector<double> inv_a, inv_b, row_c;
+  inv_a.resize(R);
+  inv_b.resize(R);
+  row_c.resize(R);
+  for (std::size_t k = 0; k < R; ++k) {
+    inv_a[k] = inv(rows[k].a);
+    inv_b[k] = inv(rows[k].b);
+    row_c[k] = rows[k].tangent ? contacts[rows[k].contact].mu_s : contacts[rows[k].contact].target;
+  }
   for (int iter = 0; iter < max_iter && !solved && friction; ++iter) {
     double change = 0.0;
     for (std::size_t k = 0; k < R; ++k) {
@@ -394,18 +406,18 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       const Vec2 db = slot_b[k] >= 0 ? dv[static_cast<std::size_t>(slot_b[k])] : Vec2{};
       const double wk = w0[k] + dot(db - da, rk.d);
       if (rk.tangent) {
-        const double bound = contacts[rk.contact].mu_s * p[k - 1];
+        const double bound = row_c[k] * p[k - 1];
         pnew[k] = std::clamp(p[k] - omega[k] * wk / akk, -bound, bound);
       } else {
-        pnew[k] = std::max(0.0, p[k] + omega[k] * (contacts[rk.contact].target - wk) / akk);
+        pnew[k] = std::max(0.0, p[k] + omega[k] * (row_c[k] - wk) / akk);
       }
     }
     for (std::size_t k = 0; k < R; ++k) {
       const Row& rk = rows[k];
       const double dp = pnew[k] - p[k];
       if (dp != 0.0) {
-        if (slot_a[k] >= 0) dv[static_cast<std::size_t>(slot_a[k])] -= (dp * inv(rk.a)) * rk.d;
-        if (slot_b[k] >= 0) dv[static_cast<std::size_t>(slot_b[k])] += (dp * inv(rk.b)) * rk.d;
+        if (slot_a[k] >= 0) dv[static_cast<std::size_t>(slot_a[k])] -= (dp * inv_a[k]) * rk.d;
+        if (slot_b[k] >= 0) dv[static_cast<std::size_t>(slot_b[k])] += (dp * inv_b[k]) * rk.d;
       }
       change = std::max(change, std::fabs(dp));
       p[k] = pnew[k];
@@ -422,11 +434,11 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       const Vec2 da = slot_a[k] >= 0 ? dv[static_cast<std::size_t>(slot_a[k])] : Vec2{};
       const Vec2 db = slot_b[k] >= 0 ? dv[static_cast<std::size_t>(slot_b[k])] : Vec2{};
       const double wk = w0[k] + dot(db - da, rk.d);
-      const double pk = std::max(0.0, p[k] + (contacts[rk.contact].target - wk) / akk);
+      const double pk = std::max(0.0, p[k] + (row_c[k] - wk) / akk);
       const double dp = pk - p[k];
       if (dp != 0.0) {
-        if (slot_a[k] >= 0) dv[static_cast<std::size_t>(slot_a[k])] -= (dp * inv(rk.a)) * rk.d;
-        if (slot_b[k] >= 0) dv[static_cast<std::size_t>(slot_b[k])] += (dp * inv(rk.b)) * rk.d;
+        if (slot_a[k] >= 0) dv[static_cast<std::size_t>(slot_a[k])] -= (dp * inv_a[k]) * rk.d;
+        if (slot_b[k] >= 0) dv[static_cast<std::size_t>(slot_b[k])] += (dp * inv_b[k]) * rk.d;
       }
       change = std::max(change, std::fabs(dp));
       p[k] = pk;
