@@ -380,7 +380,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       std::int32_t n = 1;
       if (slot_a[k] >= 0) n = std::max(n, rows_on[static_cast<std::size_t>(slot_a[k])]);
       if (slot_b[k] >= 0) n = std::max(n, rows_on[static_cast<std::size_t>(slot_b[k])]);
-      omega[k] = 1.0 / static_cast<double>(n);
+      omega[k] = std::min(1.0, 1.9 / (1.0 + std::sqrt(2.0) * static_cast<double>(n - 1)));
     }
     pnew.assign(R, 0.0);
   }
@@ -395,35 +395,48 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     inv_b[k] = inv(rows[k].b);
     row_c[k] = rows[k].tangent ? contacts[rows[k].contact].mu_s : contacts[rows[k].contact].target;
   }
-  for (int iter = 0; iter < max_iter && !solved && friction; ++iter) {
-    double change = 0.0;
+  if (friction && !solved) {
+    // The sweep's data packed per row (faces write to a spare slot with a zero inverse
+    // mass, so no branch): its bodies' slots, direction, step omega / A_kk.
+    const std::size_t spare = bodies.size();
+    dv.resize(spare + 1);
+    dv[spare] = Vec2{};
+    thread_local std::vector<std::uint32_t> sa, sb;
+    thread_local std::vector<Vec2> dir;
+    thread_local std::vector<double> step;
+    sa.resize(R);
+    sb.resize(R);
+    dir.resize(R);
+    step.resize(R);
     for (std::size_t k = 0; k < R; ++k) {
-      pnew[k] = p[k];
-      const double akk = A[k];
-      if (!(akk > 0.0)) continue;
-      const Row& rk = rows[k];
-      const Vec2 da = slot_a[k] >= 0 ? dv[static_cast<std::size_t>(slot_a[k])] : Vec2{};
-      const Vec2 db = slot_b[k] >= 0 ? dv[static_cast<std::size_t>(slot_b[k])] : Vec2{};
-      const double wk = w0[k] + dot(db - da, rk.d);
-      if (rk.tangent) {
-        const double bound = row_c[k] * p[k - 1];
-        pnew[k] = std::clamp(p[k] - omega[k] * wk / akk, -bound, bound);
-      } else {
-        pnew[k] = std::max(0.0, p[k] + omega[k] * (row_c[k] - wk) / akk);
-      }
+      sa[k] = slot_a[k] >= 0 ? static_cast<std::uint32_t>(slot_a[k]) : static_cast<std::uint32_t>(spare);
+      sb[k] = slot_b[k] >= 0 ? static_cast<std::uint32_t>(slot_b[k]) : static_cast<std::uint32_t>(spare);
+      if (slot_a[k] < 0) inv_a[k] = 0.0;
+      if (slot_b[k] < 0) inv_b[k] = 0.0;
+      dir[k] = rows[k].d;
     }
-    for (std::size_t k = 0; k < R; ++k) {
-      const Row& rk = rows[k];
-      const double dp = pnew[k] - p[k];
-      if (dp != 0.0) {
-        if (slot_a[k] >= 0) dv[static_cast<std::size_t>(slot_a[k])] -= (dp * inv_a[k]) * rk.d;
-        if (slot_b[k] >= 0) dv[static_cast<std::size_t>(slot_b[k])] += (dp * inv_b[k]) * rk.d;
+    for (std::size_t k = 0; k < R; ++k) step[k] = A[k] > 0.0 ? omega[k] / A[k] : 0.0;
+    for (int iter = 0; iter < max_iter; ++iter) {
+      for (std::size_t k = 0; k < R; ++k) {
+        const double wk = w0[k] + dot(dv[sb[k]] - dv[sa[k]], dir[k]);
+        if (rows[k].tangent) {
+          const double bound = row_c[k] * p[k - 1];
+          pnew[k] = std::clamp(p[k] - step[k] * wk, -bound, bound);
+        } else {
+          pnew[k] = std::max(0.0, p[k] + step[k] * (row_c[k] - wk));
+        }
       }
-      change = std::max(change, std::fabs(dp));
-      p[k] = pnew[k];
-      pmax = std::max(pmax, std::fabs(p[k]));
+      double change = 0.0;
+      for (std::size_t k = 0; k < R; ++k) {
+        const double dp = pnew[k] - p[k];
+        dv[sa[k]] -= (dp * inv_a[k]) * dir[k];
+        dv[sb[k]] += (dp * inv_b[k]) * dir[k];
+        change = std::max(change, std::fabs(dp));
+        p[k] = pnew[k];
+        pmax = std::max(pmax, std::fabs(p[k]));
+      }
+      if (change <= stop * pmax) break;
     }
-    if (change <= stop * pmax) break;
   }
   for (int iter = 0; iter < max_iter && !solved && !friction; ++iter) {
     double change = 0.0;
