@@ -483,7 +483,14 @@ class EventLoop {
       }
       return false;
     };
-    if (!settled && resolve_simultaneous(w_, i, j, t, set_, impacted_, min_sep)) {
+    // A body met again and again at one instant by contacts that each look separating
+    // once the other has been resolved (a body falling into a slot between two at rest):
+    // its set takes every touching contact, separating or not, so that all are solved
+    // at once.
+    w_.sim_with_separating = cycling;
+    const bool simultaneous = !settled && resolve_simultaneous(w_, i, j, t, set_, impacted_, min_sep);
+    w_.sim_with_separating = false;
+    if (simultaneous) {
       if (wedged()) ++w_.stats.wedged;
       finish_simultaneous(t, t_abs);
       return;

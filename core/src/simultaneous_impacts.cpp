@@ -61,7 +61,7 @@ bool touching(const World& w, std::uint32_t i, std::uint32_t j, double t, Contac
   const Vec2 vi = w.vel_at(i, t), vj = w.vel_at(j, t);
   const double wn = dot(vj - vi, n);
   const double vscale = length(vi) + length(vj);
-  if (wn > kGapUlps * kEps * vscale) return false;   // separating: no contact
+  if (wn > kGapUlps * kEps * vscale && !w.sim_with_separating) return false;   // separating: no contact
   c.a = i;
   c.b = j;
   c.n = n;
@@ -82,7 +82,7 @@ bool touching_face(const World& w, std::uint32_t i, std::uint32_t k, double t, C
   const Vec2 n = D >= 0.0 ? s.normal : -s.normal;
   const Vec2 v = w.vel_at(i, t);
   const double vscale = length(v);
-  if (dot(v, n) > kGapUlps * kEps * vscale) return false;
+  if (dot(v, n) > kGapUlps * kEps * vscale && !w.sim_with_separating) return false;
   c.a = kSegmentContact | k;
   c.b = i;
   c.n = n;
@@ -112,10 +112,20 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   if (w.impact_law != ImpactLaw::Simultaneous || w.any_rules) return false;
   const bool face_seed = (j0 & kSegmentContact) != 0;
   // A slow seed impact (below the collapse speed) meets bodies at rest as fixed ones.
+  // Slow is the normal closing speed, as on the pairwise path: a body sliding fast past
+  // a held one with a tiny normal approach is a slow impact (taking it as fast pushed
+  // the held body along its face, the hold stopped it again at the same instant and the
+  // same impact recurred: a frictionless pile reached the event cap so).
   bool fixed_rest = false;
   if (!w.acc.empty()) {
     const Vec2 vj = face_seed ? Vec2{} : w.vel_at(j0, t);
-    fixed_rest = length(vj - w.vel_at(i0, t)) < w.collapse_speed(i0, face_seed ? i0 : j0);
+    double closing = length(vj - w.vel_at(i0, t));
+    if (!face_seed) {
+      const Vec2 d = w.pos_at(j0, t) - w.pos_at(i0, t);
+      const double dl = length(d);
+      if (dl > 0.0) closing = std::max(0.0, -dot(vj - w.vel_at(i0, t), d / dl));
+    }
+    fixed_rest = closing < w.collapse_speed(i0, face_seed ? i0 : j0);
   }
   if (!eligible_body(w, i0, fixed_rest) || (!face_seed && !eligible_body(w, j0, fixed_rest))) return false;
   if (fixed(w, i0, fixed_rest) && (face_seed || fixed(w, j0, fixed_rest))) return false;

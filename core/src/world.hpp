@@ -129,6 +129,10 @@ struct World {
   Integrator integrator = Integrator::VelocityVerlet;
   CollisionMode mode = CollisionMode::Exact;
   ImpactLaw impact_law = ImpactLaw::Simultaneous;
+  // Set by the event loop while a body cycles through impacts at one instant: the
+  // simultaneous set then takes its touching contacts that separate too (the LCP gives
+  // them no impulse unless the others' impulses would close them).
+  bool sim_with_separating = false;
   BroadPhaseKind broadphase = BroadPhaseKind::Grid;
   bool broadphase_auto = true;
   double cell_size = 0.0;
