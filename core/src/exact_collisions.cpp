@@ -164,6 +164,12 @@ class EventLoop {
     const Vec2 dv = vj - vi;
     const Vec2 da = w_.path_acc(j) - w_.path_acc(i);
     const double R = w_.radius[i] + w_.radius[j];
+    // Apart (or just touching), not approaching and not accelerating together: with
+    // d = pj - pi, |d + dv s + da s^2 / 2|^2 >= |d|^2 >= R^2 for every s >= 0, so no
+    // impact this step. (A touching pair sliding side by side, d.dv = d.da = 0, was
+    // otherwise read as an impact at once, again and again, by the gap's tolerance.)
+    const Vec2 d0 = pj - pi;
+    if (dot(d0, dv) >= 0.0 && dot(d0, da) >= 0.0 && length_squared(d0) >= R * R) return;
     const double scale = inf_norm(pi) + inf_norm(pj) + R;
     // Round-off in dv is that of the bodies' own velocities, not of their difference: two
     // touching bodies moving together (an inelastic pair) approach at ~1e-17 m/s, an
