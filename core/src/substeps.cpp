@@ -29,8 +29,22 @@
 // body with such forces, 4 acceleration evaluations for the new sub-step, and for
 // RK4 2 per gap evaluation of the refinement (typically 4 of them).
 // Explicit and semi-implicit Euler are first order with or without an impact inside
-// a step and keep their lecture paths. Newtonian gravity couples every body's path, so
-// its scenes keep one sub-step per step (an impact there costs RK4 its order).
+// a step and keep their lecture paths.
+//
+// Newtonian gravity couples every body's path: each body's stages depend on every
+// other body's stage positions, so no body can be cut alone (integrating one to its
+// impact with the others frozen, or on their parabolas, is first order). There the
+// whole system is cut (coupled sub-steps, below, driven by the exact loop): every free
+// body's sub-step starts at one time tcut; an event that changes a path (an impact, a
+// settle, a release, a particle's death) is found on the paths, its time moved to the
+// root of the gap on Phi of the whole system (RK4: one RK4 step of all bodies from tcut
+// to t, 2 N-body acceleration evaluations per gap evaluation; Verlet: its parabolas),
+// every free body is put at Phi(t), the event is processed, and the system starts a new
+// sub-step at t to the step's end (its stages over T - t, new paths, every body's events
+// found again). Each piece is one step of the scheme for the whole system, so the order
+// holds. Cost, per such event: the gap evaluations of the search (RK4), 3 (RK4) or 1 (Verlet)
+// N-body evaluations for the cut, 4 (RK4) or 1 (Verlet) for the new sub-step, and a
+// broad-phase rebuild; scenes without Newtonian gravity pay one branch per event.
 #include <algorithm>
 #include <cmath>
 #include <limits>

@@ -388,7 +388,8 @@ double support_leave_time(const World& w, std::uint32_t i, double t, double T);
 // Sub-steps (substeps.cpp): an impact inside a step keeps the integrator's order.
 // Whether body i follows sub-steps of its integrator, so that a velocity change inside
 // a step starts a new one: state-dependent forces, velocity Verlet or RK4, no Newtonian
-// gravity, free or sliding on a face (not at rest on bodies).
+// gravity (there the whole system is cut: coupled sub-steps, below), free or sliding on
+// a face (not at rest on bodies).
 bool uses_substeps(const World& w, std::uint32_t i);
 // The acceleration of body i on sub-steps at velocity v: its forces', or on a face the
 // support's law with friction against the sliding direction of the sub-step's start.
