@@ -261,3 +261,46 @@ TEST(CoreNewtonianContact, ThreeBodiesWithWallsKeepTheIntegratorsOrder) {
 }
 
 }  // namespace physval::test
+
+namespace physval::test {
+
+// Inelastic bodies attracting each other in a uniform field come to rest on a floor
+// and on each other (micro-bounces, settling, a stack): every event cuts the whole
+// system's step, and the run still ends at rest, without overlap, never at the event cap.
+TEST(CoreNewtonianContact, InelasticBodiesSettleOnAFloor) {
+  for (const char* integrator : {"rk4", "velocity_verlet"}) {
+    SCOPED_TRACE(integrator);
+    BodyDef a = circle("a", {0.0, 1.0}, {0.5, 0.0}, 0.3, 1.0, 0.3);
+    BodyDef b = circle("b", {1.2, 1.8}, {-0.3, 0.0}, 0.4, 2.0, 0.3);
+    BodyDef c = circle("c", {0.5, 2.8}, {0.0, 0.0}, 0.25, 0.5, 0.3);
+    for (BodyDef* x : {&a, &b, &c}) {
+      x->friction = 0.5;
+      x->static_friction = 0.5;
+    }
+    Scene s = scene_of({a, b, c},
+                       {wall("floor", {-5.0, 0.0}, {5.0, 0.0}, 0.3, 0.5), wall("left", {-1.0, 0.0}, {-1.0, 5.0}, 0.3, 0.5),
+                        wall("right", {2.5, 0.0}, {2.5, 5.0}, 0.3, 0.5)},
+                       {0.0, -9.8});
+    s.world.newtonian = true;
+    s.world.G = 0.5;
+    Sim sim(s, options(integrator));
+    long impacts = 0;
+    for (int k = 0; k < 600; ++k) {
+      sim.step(1.0 / 60.0);
+      ASSERT_EQ(sim.engine.broken_guarantee(), "") << "step " << k;
+      impacts += sim.engine.last_step_stats().impacts;
+    }
+    EXPECT_GT(impacts, 20);   // they did bounce, settle and meet
+    sim.engine.read_states(sim.states);
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_LT(length(sim.states[i].velocity), 1e-3) << s.bodies[i].name;
+      EXPECT_GE(sim.states[i].position.y, s.bodies[i].radius - 1e-9) << s.bodies[i].name;
+      for (std::size_t j = i + 1; j < 3; ++j) {
+        EXPECT_GE(length(sim.states[j].position - sim.states[i].position),
+                  s.bodies[i].radius + s.bodies[j].radius - 1e-9);
+      }
+    }
+  }
+}
+
+}  // namespace physval::test
