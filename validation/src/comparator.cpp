@@ -346,6 +346,7 @@ Reference make_reference(const Scene& scene, const RunOptions& options) {
     coarse_run = fine_run.status == RunStatus::Ok ? run_engine_isolated(std::move(s), *engine, ro) : fine_run;
   }
   ref.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  ref.child_cpu_seconds = fine_run.child_cpu_seconds + (fine_run.status == RunStatus::Ok ? coarse_run.child_cpu_seconds : 0.0);
   ref.dt = fine.dt;
   if (fine_run.status != RunStatus::Ok || coarse_run.status != RunStatus::Ok) {
     const RunRecord& bad = fine_run.status != RunStatus::Ok ? fine_run : coarse_run;

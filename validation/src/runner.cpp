@@ -5,6 +5,7 @@
 #include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -15,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <numbers>
 #include <sstream>
 
@@ -217,6 +219,8 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     containment.start(states);
     double wall = 0.0;
     const double last_dt = scene.last_step();
+    const double loop_cpu0 = thread_cpu_seconds();
+    const auto loop_t0 = clock::now();
     for (long k = 1; k <= n && r.status == RunStatus::Ok; ++k) {
       const double h = k == n ? last_dt : scene.dt;
       const auto t0 = clock::now();
@@ -247,6 +251,11 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
       update_probes(t, h, true);
     }
     r.wall_seconds = wall;
+    {
+      const double loop_cpu = thread_cpu_seconds() - loop_cpu0;
+      const double loop_wall = std::chrono::duration<double>(clock::now() - loop_t0).count();
+      r.step_cpu_seconds = loop_wall > 0.0 ? std::min(loop_cpu, loop_cpu * wall / loop_wall) : 0.0;
+    }
     r.limits_hit = engine->limits_hit();
     engine->read_states(states);
     r.final_states = states;
@@ -400,8 +409,11 @@ RunRecord run_isolated(const Scene& scene, const EngineFactory& factory, const R
   if (timed_out) ::kill(pid, SIGKILL);
   forget_live_child(pid);   // before reaping: an unreaped pid cannot be reused by another process
   int wstatus = 0;
-  while (::waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
+  struct rusage usage{};
+  while (::wait4(pid, &wstatus, 0, &usage) < 0 && errno == EINTR) {
   }
+  fallback.child_cpu_seconds = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                               1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
   if (timed_out) {
     fallback.reason = "timed out after " + seconds_text(options.timeout_seconds) + " s";
     return fallback;
@@ -419,10 +431,17 @@ RunRecord run_isolated(const Scene& scene, const EngineFactory& factory, const R
     fallback.reason = "could not read the engine process's result: " + read_error;
     return fallback;
   }
+  record->child_cpu_seconds = fallback.child_cpu_seconds;
   return std::move(*record);
 }
 
 }  // namespace
+
+double thread_cpu_seconds() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
 
 RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, const RunOptions& options) {
   return run_isolated(scene, factory, options, nullptr);
