@@ -18,6 +18,7 @@
 
 #include "physval/adapters/registry.hpp"
 #include "physval/validation/runner.hpp"
+#include "number_text.hpp"
 
 namespace physval {
 
@@ -323,8 +324,7 @@ void write_results(const std::filesystem::path& dir, const SuiteResult& result) 
           out += "nan";
           return;
         }
-        const auto res = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 12);
-        out.append(buf, res.ptr);
+        out.append(buf, to_chars_g12(buf, buf + sizeof buf, v));
       };
       const std::size_t nb = std::min(r.bodies.size(), kMaxBodiesInSeries);
       out += "t,energy,kinetic,potential,px,py,angular_momentum";
