@@ -397,6 +397,44 @@ class JsonStream {
     }
     os_ << std::string(static_cast<std::size_t>(2 * depth), ' ') << ']';
   }
+  // A contact {"a", "b", ["step",] "time"} at depth `depth`: the text value() gives for
+  // its json object, written without building one (results.json holds every contact of
+  // every run: tens of thousands on a gas).
+  void contact(const ContactRecord& c, bool with_step, int depth) {
+    std::string& t = text_;
+    t.clear();
+    const std::size_t pad = static_cast<std::size_t>(2 * depth);
+    auto key = [&](const char* k) {
+      t.append(pad + 2, ' ');
+      t += '"';
+      t += k;
+      t += "\": ";
+    };
+    t += "{\n";
+    key("a");
+    put_string(c.a);
+    t += ",\n";
+    key("b");
+    put_string(c.b);
+    t += ",\n";
+    if (with_step) {
+      key("step");
+      char buf[24];
+      t.append(buf, std::to_chars(buf, buf + sizeof buf, static_cast<std::int64_t>(c.step)).ptr);
+      t += ",\n";
+    }
+    key("time");
+    if (std::isfinite(c.time)) {
+      char buf[64];
+      t.append(buf, nlohmann::detail::to_chars(buf, buf + sizeof buf, c.time));
+    } else {
+      t += "null";
+    }
+    t += '\n';
+    t.append(pad, ' ');
+    t += '}';
+    os_.write(t.data(), static_cast<std::streamsize>(t.size()));
+  }
   // An object of the keys of `small` and the `big` keys written by their functions, in
   // nlohmann's (sorted) key order.
   void object(const json& small, const std::map<std::string, std::function<void(int)>>& big, int depth) {
@@ -423,7 +461,23 @@ class JsonStream {
   }
 
  private:
+  // A JSON string as nlohmann's dump writes it: plain printable ASCII as it is, anything
+  // else (escapes, UTF-8) by nlohmann itself.
+  void put_string(const std::string& v) {
+    for (const char ch : v) {
+      const auto u = static_cast<unsigned char>(ch);
+      if (u < 0x20 || u >= 0x7f || ch == '"' || ch == '\\') {
+        text_ += json(v).dump();
+        return;
+      }
+    }
+    text_ += '"';
+    text_ += v;
+    text_ += '"';
+  }
+
   std::ostream& os_;
+  std::string text_;
 };
 
 }  // namespace
@@ -446,8 +500,7 @@ void write_results_json(std::ostream& os, const SuiteResult& result) {
     std::map<std::string, std::function<void(int)>> big;
     big["contacts"] = [&](int d) {
       out.array(r.contacts.size(), d, [&](std::size_t k, int dd) {
-        const ContactRecord& c = r.contacts[k];
-        out.value({{"a", c.a}, {"b", c.b}, {"time", c.time}, {"step", c.step}}, dd);
+        out.contact(r.contacts[k], true, dd);
       });
     };
     big["final"] = [&](int d) {
@@ -469,8 +522,7 @@ void write_results_json(std::ostream& os, const SuiteResult& result) {
       contacts["contacts"] = [&](int d3) {
         const std::size_t n = sr.reference.run ? sr.reference.run->contacts.size() : 0;
         out.array(n, d3, [&](std::size_t k, int d4) {
-          const ContactRecord& c = sr.reference.run->contacts[k];
-          out.value({{"a", c.a}, {"b", c.b}, {"time", c.time}}, d4);
+          out.contact(sr.reference.run->contacts[k], false, d4);
         });
       };
       out.object(ref, contacts, dd);

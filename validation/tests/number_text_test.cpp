@@ -56,3 +56,40 @@ TEST(NumberText, EqualsToCharsOnRandomValues) {
 }
 
 }  // namespace
+
+// results.json's contacts are written as text, not through a json tree: the text must be
+// the tree's dump for any names and times.
+#include <sstream>
+
+#include "physval/validation/results_json.hpp"
+
+namespace {
+
+TEST(NumberText, StreamedContactsAreTheTreesDumpForOddNamesAndTimes) {
+  physval::SuiteResult result;
+  physval::ScenarioResult sr;
+  sr.scene.name = "odd";
+  physval::RunRecord r;
+  r.scenario = "odd";
+  r.engine = "core";
+  const double inf = std::numeric_limits<double>::infinity();
+  const std::string names[] = {"plain", "quote\"d", "back\\slash", "tab\there", "caf\xc3\xa9", "del\x7f", "", "c0"};
+  const double times[] = {0.0, -0.0, 1.0, 0.1, 1e-300, 123456789.123, -2.5, inf, -inf, std::nan(""), 1.0 / 3.0};
+  long step = -3;
+  for (const std::string& a : names) {
+    for (const double t : times) r.contacts.push_back({a, names[static_cast<std::size_t>(step + 3) % 8], t, step++});
+  }
+  physval::RunRecord ref = r;
+  ref.engine = "reference";
+  sr.reference.available = true;
+  sr.reference.run = ref;
+  sr.runs.push_back(r);
+  result.scenarios.push_back(sr);
+  std::ostringstream streamed;
+  physval::write_results_json(streamed, result);
+  nlohmann::json tree = physval::suite_to_json(result);
+  tree["context"] = nlohmann::json::parse(streamed.str())["context"];
+  EXPECT_EQ(streamed.str(), tree.dump(2) + "\n");
+}
+
+}  // namespace
