@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 namespace physval {
@@ -78,6 +79,7 @@ ContainmentMonitor::ContainmentMonitor(const Scene& scene) : scene_(scene) {
   }
   eps_ = 1e-9 * extent;
   for (const BodyDef& d : scene.bodies) radius_.push_back(d.shape == ShapeKind::Point ? 0.0 : d.radius);
+  max_radius_ = max_radius;
   for (const Barrier& b : barriers_) {
     const double r = b.circle ? b.radius : 0.0;
     barrier_lo_.push_back({std::min(b.a.x, b.b.x) - r - 2.0 * eps_, std::min(b.a.y, b.b.y) - r - 2.0 * eps_});
@@ -214,16 +216,28 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
     }
     order_[q] = v;
   }
-  for (std::size_t p = 0; p < order_.size(); ++p) {
+  // The sweep reads the bodies in x order from arrays laid out in that order.
+  const std::size_t n = order_.size();
+  sorted_lo_.resize(n);
+  sorted_y_.resize(n);
+  for (std::size_t p = 0; p < n; ++p) {
+    const std::size_t i = order_[p];
+    sorted_lo_[p] = lo_[i];
+    // A body that is not alive is never paired: NaN fails every comparison below.
+    sorted_y_[p] = alive_[i] ? pos_[i].y : std::numeric_limits<double>::quiet_NaN();
+  }
+  for (std::size_t p = 0; p < n; ++p) {
     const std::size_t i = order_[p];
     if (!alive_[i]) continue;
     const Vec2 xi = pos_[i];
     const double ri = radius_[i];
     const double hi = xi.x + ri;
     const std::size_t gi = body_group_[i] * n_body_groups_;
-    for (std::size_t q = p + 1; q < order_.size() && lo_[order_[q]] <= hi; ++q) {
+    for (std::size_t q = p + 1; q < n && sorted_lo_[q] <= hi; ++q) {
+      // Farther apart in y than the radii together could be (max_radius_ bounds rj) or
+      // not alive (NaN): skipped without touching anything else of j.
+      if (!(std::fabs(xi.y - sorted_y_[q]) <= (ri + max_radius_) * (1.0 + 1e-9))) continue;
       const std::size_t j = order_[q];
-      if (!alive_[j]) continue;
       const double rj = radius_[j];
       const Vec2 xj = pos_[j];
       // Farther apart in y than the radii together (with a margin far above rounding):

@@ -66,6 +66,8 @@ class ContainmentMonitor {
   std::vector<double> lo_;                  // position.x - radius
   std::vector<Vec2> pos_;
   std::vector<char> alive_;
+  std::vector<double> sorted_lo_, sorted_y_;   // lo_ and y (NaN: not alive) in order_'s order
+  double max_radius_ = 0.0;                    // of the moving bodies
   std::vector<std::uint32_t> on_line_count_;   // on_line_ entries of the body
   // Each barrier's bounding box, widened by 2 eps: a body's path whose box misses it
   // can neither touch nor cross it (see observe).
