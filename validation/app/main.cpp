@@ -1,5 +1,6 @@
 // physval: the command. Exit status 0: everything ran and held; 1: a gate or an
 // expectation failed, or an engine diverged; 2: bad input or usage, nothing was run.
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -65,6 +66,7 @@ struct CommonOptions {
   std::vector<std::string> paths;
   std::vector<std::string> engines;
   std::string out = "physval-out";
+  std::string overhead;   // --overhead FILE
   std::string dt;
   std::string duration;
   bool no_isolate = false;
@@ -112,6 +114,9 @@ void add_common(CLI::App* cmd, CommonOptions& o) {
   cmd->add_flag("--no-cache", o.no_cache, "compute every reference, read and write no cache");
   cmd->add_option("--max-memory", o.max_memory_mb,
                   "MB a scene's estimated memory may reach (default 0: half of this machine's memory)");
+  cmd->add_option("--overhead", o.overhead,
+                  "also write here (JSON) the harness's CPU per scenario next to the engines' stepping "
+                  "(scripts/overhead.sh prints it as a table)");
   add_plugin_option(cmd, o.plugins);
   cmd->add_option("-j,--jobs", o.jobs, "references and engine runs at once (default 0: every core); results do not depend on it");
   cmd->add_option("--shard", o.shard,
@@ -345,6 +350,15 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
     if (!junit.empty()) {
       write_file_atomically(junit, junit_xml(result));
       std::cout << "junit: " << junit << '\n';
+    }
+    if (!o.overhead.empty()) {
+      // Last, after everything else this command does: its CPU so far, children included.
+      rusage self{}, children{};
+      ::getrusage(RUSAGE_SELF, &self);
+      ::getrusage(RUSAGE_CHILDREN, &children);
+      auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); };
+      const double cpu = seconds(self.ru_utime) + seconds(self.ru_stime) + seconds(children.ru_utime) + seconds(children.ru_stime);
+      write_file_atomically(o.overhead, overhead_json(result, cpu).dump(2) + "\n");
     }
   } catch (const std::exception& e) {
     std::cerr << "physval: could not write the results: " << e.what() << '\n';

@@ -9,6 +9,8 @@
 #include <limits>
 #include <map>
 #include <sstream>
+#include <string_view>
+#include <unordered_map>
 
 #include "physval/adapters/registry.hpp"
 #include "physval/validation/conservation.hpp"
@@ -130,15 +132,30 @@ ContactMatch match_contacts(const std::vector<ContactRecord>& run, const std::ve
     std::vector<double> ref_min_after;   // min time of ref[k..] (suffix minimum)
     std::size_t ref_seen = 0;
   };
-  std::map<std::pair<std::string, std::string>, PairQueue> pairs;
-  for (std::size_t j = 0; j < run.size(); ++j) pairs[pair_key(run[j].a, run[j].b)].run.push_back(j);
-  std::vector<PairQueue*> ref_queue(ref.size(), nullptr);
+  // Pairs by the ids of their names (the unordered pair: smaller id first), no strings
+  // copied: a gas has thousands of contacts.
+  std::unordered_map<std::string_view, std::uint32_t> ids;
+  auto id = [&](const std::string& name) {
+    return ids.emplace(std::string_view(name), static_cast<std::uint32_t>(ids.size())).first->second;
+  };
+  std::unordered_map<std::uint64_t, std::size_t> pair_index;
+  std::vector<PairQueue> pairs;
+  auto queue = [&](const ContactRecord& c) -> std::size_t {
+    const std::uint32_t x = id(c.a), y = id(c.b);
+    const std::uint64_t key = (static_cast<std::uint64_t>(std::min(x, y)) << 32) | std::max(x, y);
+    const auto [it, added] = pair_index.emplace(key, pairs.size());
+    if (added) pairs.emplace_back();
+    return it->second;
+  };
+  ids.reserve(64);
+  pair_index.reserve(run.size() + ref.size());
+  for (std::size_t j = 0; j < run.size(); ++j) pairs[queue(run[j])].run.push_back(j);
+  std::vector<std::size_t> ref_queue(ref.size());
   for (std::size_t i = 0; i < ref.size(); ++i) {
-    PairQueue& q = pairs[pair_key(ref[i].a, ref[i].b)];
-    q.ref.push_back(i);
-    ref_queue[i] = &q;
+    ref_queue[i] = queue(ref[i]);
+    pairs[ref_queue[i]].ref.push_back(i);
   }
-  for (auto& [key, q] : pairs) {
+  for (PairQueue& q : pairs) {
     q.ref_min_after.resize(q.ref.size());
     double least = std::numeric_limits<double>::infinity();
     for (std::size_t k = q.ref.size(); k-- > 0;) {
@@ -148,7 +165,7 @@ ContactMatch match_contacts(const std::vector<ContactRecord>& run, const std::ve
   }
   std::vector<bool> used(run.size(), false);
   for (std::size_t i = 0; i < ref.size(); ++i) {
-    PairQueue& q = *ref_queue[i];
+    PairQueue& q = pairs[ref_queue[i]];
     const double earliest_wanted = q.ref_min_after[q.ref_seen++] - window;
     while (q.cursor < q.run.size() && (used[q.run[q.cursor]] || run[q.run[q.cursor]].time < earliest_wanted)) {
       ++q.cursor;
@@ -346,6 +363,7 @@ Reference make_reference(const Scene& scene, const RunOptions& options) {
     coarse_run = fine_run.status == RunStatus::Ok ? run_engine_isolated(std::move(s), *engine, ro) : fine_run;
   }
   ref.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  ref.child_cpu_seconds = fine_run.child_cpu_seconds + (fine_run.status == RunStatus::Ok ? coarse_run.child_cpu_seconds : 0.0);
   ref.dt = fine.dt;
   if (fine_run.status != RunStatus::Ok || coarse_run.status != RunStatus::Ok) {
     const RunRecord& bad = fine_run.status != RunStatus::Ok ? fine_run : coarse_run;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 namespace physval {
@@ -77,6 +78,13 @@ ContainmentMonitor::ContainmentMonitor(const Scene& scene) : scene_(scene) {
     extent = std::max({extent, std::fabs(b.a.x), std::fabs(b.a.y), std::fabs(b.b.x), std::fabs(b.b.y)});
   }
   eps_ = 1e-9 * extent;
+  for (const BodyDef& d : scene.bodies) radius_.push_back(d.shape == ShapeKind::Point ? 0.0 : d.radius);
+  max_radius_ = max_radius;
+  for (const Barrier& b : barriers_) {
+    const double r = b.circle ? b.radius : 0.0;
+    barrier_lo_.push_back({std::min(b.a.x, b.b.x) - r - 2.0 * eps_, std::min(b.a.y, b.b.y) - r - 2.0 * eps_});
+    barrier_hi_.push_back({std::max(b.a.x, b.b.x) + r + 2.0 * eps_, std::max(b.a.y, b.b.y) + r + 2.0 * eps_});
+  }
 
   std::vector<std::string> bg_names(barrier_groups.size()), mg_names(body_groups.size());
   for (const auto& [name, id] : barrier_groups) bg_names[id] = name;
@@ -178,49 +186,72 @@ void ContainmentMonitor::start(const std::vector<BodyState>& states) {
     previous_alive_[i] = states[i].alive ? 1 : 0;
   }
   order_ = moving_;
+  lo_.assign(scene_.bodies.size(), 0.0);
+  pos_.assign(scene_.bodies.size(), Vec2{});
+  alive_.assign(scene_.bodies.size(), 0);
+  on_line_count_.assign(scene_.bodies.size(), 0);
   record_.measured = true;
   observe(0.0, states);
 }
 
 void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states) {
   const std::size_t nb = std::min(states.size(), scene_.bodies.size());
-  auto radius = [&](std::size_t i) {
-    const BodyDef& d = scene_.bodies[i];
-    return d.shape == ShapeKind::Point ? 0.0 : d.radius;
-  };
-  auto position = [&](std::size_t i) { return i < nb ? states[i].position : scene_.bodies[i].position; };
-  auto alive = [&](std::size_t i) { return i < nb && states[i].alive && is_finite(states[i].position); };
+  // The moving bodies' positions, left ends and liveness, read once into compact arrays.
+  for (const std::size_t i : moving_) {
+    const Vec2 x = i < nb ? states[i].position : scene_.bodies[i].position;
+    pos_[i] = x;
+    lo_[i] = x.x - radius_[i];
+    alive_[i] = i < nb && states[i].alive && is_finite(states[i].position);
+  }
 
   // Moving pairs: a sweep over x, the order kept from the step before (insertion sort
   // is linear on an almost sorted list).
-  auto lo = [&](std::size_t i) { return position(i).x - radius(i); };
   for (std::size_t p = 1; p < order_.size(); ++p) {
     const std::size_t v = order_[p];
-    const double key = lo(v);
+    const double key = lo_[v];
     std::size_t q = p;
-    while (q > 0 && lo(order_[q - 1]) > key) {
+    while (q > 0 && lo_[order_[q - 1]] > key) {
       order_[q] = order_[q - 1];
       --q;
     }
     order_[q] = v;
   }
-  for (std::size_t p = 0; p < order_.size(); ++p) {
+  // The sweep reads the bodies in x order from arrays laid out in that order.
+  const std::size_t n = order_.size();
+  sorted_lo_.resize(n);
+  sorted_y_.resize(n);
+  for (std::size_t p = 0; p < n; ++p) {
     const std::size_t i = order_[p];
-    if (!alive(i)) continue;
-    const Vec2 xi = position(i);
-    const double hi = xi.x + radius(i);
-    for (std::size_t q = p + 1; q < order_.size() && lo(order_[q]) <= hi; ++q) {
+    sorted_lo_[p] = lo_[i];
+    // A body that is not alive is never paired: NaN fails every comparison below.
+    sorted_y_[p] = alive_[i] ? pos_[i].y : std::numeric_limits<double>::quiet_NaN();
+  }
+  for (std::size_t p = 0; p < n; ++p) {
+    const std::size_t i = order_[p];
+    if (!alive_[i]) continue;
+    const Vec2 xi = pos_[i];
+    const double ri = radius_[i];
+    const double hi = xi.x + ri;
+    const std::size_t gi = body_group_[i] * n_body_groups_;
+    for (std::size_t q = p + 1; q < n && sorted_lo_[q] <= hi; ++q) {
+      // Farther apart in y than the radii together could be (max_radius_ bounds rj) or
+      // not alive (NaN): skipped without touching anything else of j.
+      if (!(std::fabs(xi.y - sorted_y_[q]) <= (ri + max_radius_) * (1.0 + 1e-9))) continue;
       const std::size_t j = order_[q];
-      if (!alive(j)) continue;
-      if (!pair_collides_[body_group_[i] * n_body_groups_ + body_group_[j]]) continue;
-      const double depth = radius(i) + radius(j) - length(xi - position(j));
+      const double rj = radius_[j];
+      const Vec2 xj = pos_[j];
+      // Farther apart in y than the radii together (with a margin far above rounding):
+      // the distance is too, the depth below is negative and nothing below can happen.
+      if (std::fabs(xi.y - xj.y) > (ri + rj) * (1.0 + 1e-9)) continue;
+      if (!pair_collides_[gi + body_group_[j]]) continue;
+      const double depth = ri + rj - length(xi - xj);
       if (depth > record_.max_penetration) {
         penetration(depth, t, scene_.bodies[std::min(i, j)].name + " / " + scene_.bodies[std::max(i, j)].name);
       }
       // Passed into each other: the centres closer than the smaller radius (each centre
       // inside the other body; overlap deeper than the larger radius). No solver's slop
       // comes near it: the pair has gone through, or is on its way.
-      if (depth > std::max(radius(i), radius(j)) + eps_ && std::min(radius(i), radius(j)) > 0.0) {
+      if (depth > std::max(ri, rj) + eps_ && std::min(ri, rj) > 0.0) {
         for (const std::size_t k : {i, j}) {
           if (escaped_[k]) continue;
           escaped_[k] = 1;
@@ -236,20 +267,19 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
 
   // Each moving body against the barriers near its path since the last step.
   for (std::size_t i : moving_) {
-    if (!alive(i)) {
+    if (!alive_[i]) {
       previous_alive_[i] = 0;
       continue;
     }
-    const double r = radius(i);
-    const Vec2 p1 = position(i);
+    const double r = radius_[i];
+    const Vec2 p1 = pos_[i];
     const Vec2 p0 = previous_alive_[i] ? previous_[i] : p1;
     const Vec2 lo_corner{std::min(p0.x, p1.x) - r, std::min(p0.y, p1.y) - r};
     const Vec2 hi_corner{std::max(p0.x, p1.x) + r, std::max(p0.y, p1.y) + r};
-    candidates(lo_corner, hi_corner);
     const std::vector<char>& blocks = blocks_[body_group_[i]];
-    for (std::uint32_t k : found_) {
+    auto check = [&](std::uint32_t k) {
       const Barrier& b = barriers_[k];
-      if (!blocks[b.group]) continue;
+      if (!blocks[b.group]) return;
       if (b.circle) {
         const double depth = r + b.radius - length(p1 - b.a);
         if (depth > record_.max_penetration) penetration(depth, t, scene_.bodies[i].name + " / " + b.what);
@@ -257,7 +287,7 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
         const double depth = r - segment_distance(p1, b.a, b.dir, b.len);
         if (depth > record_.max_penetration) penetration(depth, t, scene_.bodies[i].name + " / " + b.what);
       }
-      if (escaped_[i] || p0 == p1) continue;
+      if (escaped_[i] || p0 == p1) return;
       bool through = false;
       if (b.circle) {
         const Vec2 d = p1 - p0;
@@ -278,12 +308,15 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
         if (s0 != 0 && s1 == -s0) {
           through = within(p0 + (p1 - p0) * (d0 / (d0 - d1)));
         } else if (s0 != 0 && s1 == 0) {
-          if (within(p1)) on_line_[key] = static_cast<signed char>(s0);   // landed on the line: remember whence
+          if (within(p1)) {   // landed on the line: remember whence
+            if (on_line_.insert_or_assign(key, static_cast<signed char>(s0)).second) ++on_line_count_[i];
+          }
         } else if (s0 == 0) {
           // Left the line it had landed on: through it when to the other side of where it came from.
           if (auto it = on_line_.find(key); it != on_line_.end() && s1 != 0) {
             through = s1 == -it->second && within(p0);
             on_line_.erase(it);
+            --on_line_count_[i];
           }
         }
       }
@@ -294,6 +327,24 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
           record_.first_escape_time = t;
           record_.first_escape = scene_.bodies[i].name + " through " + b.what;
         }
+      }
+    };
+    if (use_grid_) {
+      candidates(lo_corner, hi_corner);
+      for (const std::uint32_t k : found_) check(k);
+    } else {
+      // Few barriers: all of them, but a barrier whose box (widened by 2 eps) the path's
+      // box misses is skipped: the body's end point is farther than r from it (no
+      // penetration) and the path can neither cross it nor land on or leave its line
+      // within eps of it. A body with a remembered landing on some line checks every
+      // barrier, so that leaving that line is seen wherever it happens.
+      const bool all = on_line_count_[i] != 0;
+      for (std::uint32_t k = 0; k < barriers_.size(); ++k) {
+        if (!all && (hi_corner.x < barrier_lo_[k].x || lo_corner.x > barrier_hi_[k].x ||
+                     hi_corner.y < barrier_lo_[k].y || lo_corner.y > barrier_hi_[k].y)) {
+          continue;
+        }
+        check(k);
       }
     }
     previous_[i] = p1;

@@ -60,6 +60,18 @@ class ContainmentMonitor {
   std::size_t n_body_groups_ = 0;
   std::vector<std::size_t> moving_;         // scene bodies that are not static
   std::vector<std::size_t> order_;          // moving_, kept sorted by x - radius
+  // Per scene body, filled once (radius) or at each observe (the rest): compact arrays
+  // the sweep reads instead of the scene's BodyDefs and the engine's BodyStates.
+  std::vector<double> radius_;
+  std::vector<double> lo_;                  // position.x - radius
+  std::vector<Vec2> pos_;
+  std::vector<char> alive_;
+  std::vector<double> sorted_lo_, sorted_y_;   // lo_ and y (NaN: not alive) in order_'s order
+  double max_radius_ = 0.0;                    // of the moving bodies
+  std::vector<std::uint32_t> on_line_count_;   // on_line_ entries of the body
+  // Each barrier's bounding box, widened by 2 eps: a body's path whose box misses it
+  // can neither touch nor cross it (see observe).
+  std::vector<Vec2> barrier_lo_, barrier_hi_;
   double eps_ = 1e-9;
 
   // A uniform grid over the barriers (used when there are many).

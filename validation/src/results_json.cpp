@@ -17,6 +17,8 @@
 #include <stdexcept>
 
 #include "physval/adapters/registry.hpp"
+#include "physval/validation/runner.hpp"
+#include "number_text.hpp"
 
 namespace physval {
 
@@ -305,6 +307,7 @@ void write_results(const std::filesystem::path& dir, const SuiteResult& result) 
   // report's scene player draws every body, so the series hold up to this many.
   constexpr std::size_t kMaxBodiesInSeries = 400;
   for (const ScenarioResult& sr : result.scenarios) {
+    const double cpu0 = thread_cpu_seconds();
     {
       std::ostringstream geometry;
       write_scene_geometry(geometry, sr);
@@ -321,8 +324,7 @@ void write_results(const std::filesystem::path& dir, const SuiteResult& result) 
           out += "nan";
           return;
         }
-        const auto res = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 12);
-        out.append(buf, res.ptr);
+        out.append(buf, to_chars_g12(buf, buf + sizeof buf, v));
       };
       const std::size_t nb = std::min(r.bodies.size(), kMaxBodiesInSeries);
       out += "t,energy,kinetic,potential,px,py,angular_momentum";
@@ -354,6 +356,7 @@ void write_results(const std::filesystem::path& dir, const SuiteResult& result) 
     };
     for (const RunRecord& r : sr.runs) write_series(r, r.engine);
     if (sr.reference.run) write_series(*sr.reference.run, "reference");
+    sr.write_cpu_seconds = thread_cpu_seconds() - cpu0;
   }
   write_results_json(dir / "results.json", result);
 }
@@ -394,6 +397,44 @@ class JsonStream {
     }
     os_ << std::string(static_cast<std::size_t>(2 * depth), ' ') << ']';
   }
+  // A contact {"a", "b", ["step",] "time"} at depth `depth`: the text value() gives for
+  // its json object, written without building one (results.json holds every contact of
+  // every run: tens of thousands on a gas).
+  void contact(const ContactRecord& c, bool with_step, int depth) {
+    std::string& t = text_;
+    t.clear();
+    const std::size_t pad = static_cast<std::size_t>(2 * depth);
+    auto key = [&](const char* k) {
+      t.append(pad + 2, ' ');
+      t += '"';
+      t += k;
+      t += "\": ";
+    };
+    t += "{\n";
+    key("a");
+    put_string(c.a);
+    t += ",\n";
+    key("b");
+    put_string(c.b);
+    t += ",\n";
+    if (with_step) {
+      key("step");
+      char buf[24];
+      t.append(buf, std::to_chars(buf, buf + sizeof buf, static_cast<std::int64_t>(c.step)).ptr);
+      t += ",\n";
+    }
+    key("time");
+    if (std::isfinite(c.time)) {
+      char buf[64];
+      t.append(buf, nlohmann::detail::to_chars(buf, buf + sizeof buf, c.time));
+    } else {
+      t += "null";
+    }
+    t += '\n';
+    t.append(pad, ' ');
+    t += '}';
+    os_.write(t.data(), static_cast<std::streamsize>(t.size()));
+  }
   // An object of the keys of `small` and the `big` keys written by their functions, in
   // nlohmann's (sorted) key order.
   void object(const json& small, const std::map<std::string, std::function<void(int)>>& big, int depth) {
@@ -420,7 +461,23 @@ class JsonStream {
   }
 
  private:
+  // A JSON string as nlohmann's dump writes it: plain printable ASCII as it is, anything
+  // else (escapes, UTF-8) by nlohmann itself.
+  void put_string(const std::string& v) {
+    for (const char ch : v) {
+      const auto u = static_cast<unsigned char>(ch);
+      if (u < 0x20 || u >= 0x7f || ch == '"' || ch == '\\') {
+        text_ += json(v).dump();
+        return;
+      }
+    }
+    text_ += '"';
+    text_ += v;
+    text_ += '"';
+  }
+
   std::ostream& os_;
+  std::string text_;
 };
 
 }  // namespace
@@ -428,18 +485,22 @@ class JsonStream {
 void write_results_json(std::ostream& os, const SuiteResult& result) {
   JsonStream out(os);
   std::vector<const RunRecord*> runs;
+  std::vector<const ScenarioResult*> run_scenario;
   for (const ScenarioResult& sr : result.scenarios) {
-    for (const RunRecord& r : sr.runs) runs.push_back(&r);
+    for (const RunRecord& r : sr.runs) {
+      runs.push_back(&r);
+      run_scenario.push_back(&sr);
+    }
   }
   // Each run without its two long lists, which are streamed element by element.
   auto run_json = [&](std::size_t i, int depth) {
+    const double cpu0 = thread_cpu_seconds();
     const RunRecord& r = *runs[i];
     json small = run_to_json_without_lists(r);
     std::map<std::string, std::function<void(int)>> big;
     big["contacts"] = [&](int d) {
       out.array(r.contacts.size(), d, [&](std::size_t k, int dd) {
-        const ContactRecord& c = r.contacts[k];
-        out.value({{"a", c.a}, {"b", c.b}, {"time", c.time}, {"step", c.step}}, dd);
+        out.contact(r.contacts[k], true, dd);
       });
     };
     big["final"] = [&](int d) {
@@ -447,23 +508,25 @@ void write_results_json(std::ostream& os, const SuiteResult& result) {
       out.array(n, d, [&](std::size_t k, int dd) { out.value(final_state_json(r, k), dd); });
     };
     out.object(small, big, depth);
+    run_scenario[i]->write_cpu_seconds += thread_cpu_seconds() - cpu0;
   };
   json small = suite_to_json_without_lists(result);
   std::map<std::string, std::function<void(int)>> big;
   big["runs"] = [&](int d) { out.array(runs.size(), d, run_json); };
   big["references"] = [&](int d) {
     out.array(result.scenarios.size(), d, [&](std::size_t s, int dd) {
+      const double cpu0 = thread_cpu_seconds();
       const ScenarioResult& sr = result.scenarios[s];
       json ref = reference_json_without_contacts(sr);
       std::map<std::string, std::function<void(int)>> contacts;
       contacts["contacts"] = [&](int d3) {
         const std::size_t n = sr.reference.run ? sr.reference.run->contacts.size() : 0;
         out.array(n, d3, [&](std::size_t k, int d4) {
-          const ContactRecord& c = sr.reference.run->contacts[k];
-          out.value({{"a", c.a}, {"b", c.b}, {"time", c.time}}, d4);
+          out.contact(sr.reference.run->contacts[k], false, d4);
         });
       };
       out.object(ref, contacts, dd);
+      sr.write_cpu_seconds += thread_cpu_seconds() - cpu0;
     });
   };
   out.object(small, big, 0);
@@ -491,6 +554,54 @@ void write_results_json(const std::filesystem::path& path, const SuiteResult& re
     std::filesystem::remove(tmp);
     throw std::runtime_error("cannot rename " + tmp.string() + " to " + path.string() + ": " + ec.message());
   }
+}
+
+nlohmann::json overhead_json(const SuiteResult& result, double process_cpu_seconds) {
+  json scenarios = json::array();
+  double sum_wall = 0.0, sum_step = 0.0, sum_ref = 0.0, sum_over = 0.0;
+  for (const ScenarioResult& sr : result.scenarios) {
+    double wall = 0.0, step = 0.0, child = 0.0, parent = 0.0;
+    for (const RunRecord& r : sr.runs) {
+      wall += r.wall_seconds;
+      step += r.step_cpu_seconds;
+      child += r.child_cpu_seconds;
+      parent += r.parent_cpu_seconds;
+    }
+    // The runs' harness: their children's and the parent's CPU beyond the stepping.
+    const double runs_harness = child + parent - step;
+    const double overhead = runs_harness + sr.compare_cpu_seconds + sr.write_cpu_seconds;
+    scenarios.push_back({{"scenario", sr.scene.name},
+                         {"runs", sr.runs.size()},
+                         {"stepping_wall_seconds", wall},
+                         {"stepping_cpu_seconds", step},
+                         {"reference_cpu_seconds", sr.reference_cpu_seconds},
+                         {"runs_harness_cpu_seconds", runs_harness},
+                         {"compare_cpu_seconds", sr.compare_cpu_seconds},
+                         {"write_cpu_seconds", sr.write_cpu_seconds},
+                         {"overhead_cpu_seconds", overhead},
+                         {"overhead_percent", step > 0.0 ? json(100.0 * overhead / step) : json(nullptr)}});
+    sum_wall += wall;
+    sum_step += step;
+    sum_ref += sr.reference_cpu_seconds;
+    sum_over += overhead;
+  }
+  const double unattributed = process_cpu_seconds - sum_step - sum_ref - sum_over;
+  const double total_over = sum_over + unattributed;
+  return {{"definition",
+           "overhead = CPU of physval and its engine children minus the engines' stepping (CPU inside "
+           "step()) and the references (computed or read from the cache); per scenario: its runs' children "
+           "and parent-side CPU beyond stepping, its comparisons and its writing; the suite adds what no "
+           "scenario is charged with (start, loading, table)"},
+          {"scenarios", scenarios},
+          {"suite",
+           {{"stepping_wall_seconds", sum_wall},
+            {"stepping_cpu_seconds", sum_step},
+            {"reference_cpu_seconds", sum_ref},
+            {"scenarios_overhead_cpu_seconds", sum_over},
+            {"unattributed_cpu_seconds", unattributed},
+            {"process_cpu_seconds", process_cpu_seconds},
+            {"overhead_cpu_seconds", total_over},
+            {"overhead_percent", sum_step > 0.0 ? json(100.0 * total_over / sum_step) : json(nullptr)}}}};
 }
 
 }  // namespace physval

@@ -68,6 +68,7 @@ void write_record(Sink& sink, const RunRecord& r) {
   w.opt(r.diverged_at);
   w.f64(r.wall_seconds);
   w.f64(r.load_seconds);
+  w.f64(r.step_cpu_seconds);
   w.u64(r.settings.size());
   for (const Setting& s : r.settings) {
     w.str(s.first);
@@ -312,6 +313,7 @@ RunRecord read_record(Source& source) {
   r.diverged_at = rd.opt();
   r.wall_seconds = rd.f64();
   r.load_seconds = rd.f64();
+  r.step_cpu_seconds = rd.f64();
   for (std::uint64_t n = rd.count(), i = 0; i < n; ++i) {
     std::string k = rd.str();
     r.settings.emplace_back(std::move(k), rd.str());

@@ -87,12 +87,15 @@ SuiteResult run_suite(std::vector<Scene> scenes, const std::vector<std::string>&
       const Task& t = tasks[phase[k]];
       ScenarioResult& sr = result.scenarios[t.scenario];
       say(t);
+      const double cpu0 = thread_cpu_seconds();
       if (t.engine == nullptr) {
         sr.reference = cached_reference(sr.scene, options).reference;
+        sr.reference_cpu_seconds = thread_cpu_seconds() - cpu0 + sr.reference.child_cpu_seconds;
         return;
       }
       if (options.timeout_seconds <= 0.0) {
         sr.runs[t.slot] = run_engine_isolated(sr.scene, *t.engine, options);
+        sr.runs[t.slot].parent_cpu_seconds = thread_cpu_seconds() - cpu0;
         return;
       }
       RunOptions budget = options;
@@ -112,6 +115,7 @@ SuiteResult run_suite(std::vector<Scene> scenes, const std::vector<std::string>&
                      seconds_text(options.timeout_seconds) + " s";
         }
       }
+      r.parent_cpu_seconds = thread_cpu_seconds() - cpu0;
       sr.runs[t.slot] = std::move(r);
     });
   }
@@ -121,6 +125,7 @@ SuiteResult run_suite(std::vector<Scene> scenes, const std::vector<std::string>&
   for (const ScenarioResult& sr : result.scenarios) compare_costs.push_back(static_cast<double>(sr.runs.size()));
   run_tasks(compare_costs, jobs, [&](std::size_t s) {
     ScenarioResult& sr = result.scenarios[s];
+    const double cpu0 = thread_cpu_seconds();
     for (RunRecord& run : sr.runs) compare_run(run, sr.scene, sr.reference, enforce_gates);
     for (std::size_t i = 0; i < sr.runs.size(); ++i) {
       for (std::size_t j = i + 1; j < sr.runs.size(); ++j) {
@@ -128,6 +133,7 @@ SuiteResult run_suite(std::vector<Scene> scenes, const std::vector<std::string>&
         sr.pairs.push_back(compare_pair(sr.runs[i], sr.runs[j], sr.scene));
       }
     }
+    sr.compare_cpu_seconds = thread_cpu_seconds() - cpu0;
   });
   return result;
 }

@@ -23,6 +23,8 @@ struct Reference {
   // Wall-clock seconds its runs took when it was computed (kept in the reference cache,
   // so a reference read back is charged the same): --timeout's budget counts it.
   double seconds = 0.0;
+  // CPU of its engine children when computed here (0 when read from the cache; not cached).
+  double child_cpu_seconds = 0.0;
 };
 
 // Builds the reference for `scene` (already effective: dt/duration applied).

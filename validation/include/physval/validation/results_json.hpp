@@ -56,4 +56,10 @@ class StagedOutputFolder {
 // t, energy, kinetic, potential, px, py, angular_momentum, then x_i, y_i of each body).
 void write_results(const std::filesystem::path& dir, const SuiteResult& result);
 
+// `--overhead FILE`: the harness's cost per scenario next to the engines' stepping (README
+// "Running at scale", "Harness overhead"), all CPU seconds. `process_cpu_seconds`: user +
+// system CPU of physval and its reaped children so far (what is not attributed to a
+// scenario, e.g. start-up, loading, the table, is the suite's `unattributed`).
+nlohmann::json overhead_json(const SuiteResult& result, double process_cpu_seconds);
+
 }  // namespace physval

@@ -122,6 +122,14 @@ struct RunRecord {
   bool known_divergence = false;
   double wall_seconds = 0.0;           // time inside step() only
   double load_seconds = 0.0;
+  // Harness accounting (`physval run --overhead FILE`; not in results.json):
+  // CPU inside step(), estimated as the stepping loop's thread CPU x wall_seconds / the
+  // loop's wall time (equal to wall_seconds on an idle core, less when the run shared it);
+  double step_cpu_seconds = 0.0;
+  // the engine child's whole CPU, fork to exit (wait4's rusage; 0 for an in-process run);
+  double child_cpu_seconds = 0.0;
+  // the parent thread's CPU for the run (fork, reading the record; in-process: all of it).
+  double parent_cpu_seconds = 0.0;
   std::vector<Setting> settings;
   std::vector<std::string> limits_hit;
   std::vector<BodyMeta> bodies;

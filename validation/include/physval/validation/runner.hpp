@@ -44,6 +44,9 @@ RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& engine, c
 // releases it once the child has forked, before the record comes back.
 RunRecord run_engine_isolated(Scene&& scene, const EngineFactory& factory, const RunOptions& options);
 
+// CPU time of the calling thread (CLOCK_THREAD_CPUTIME_ID), s: the harness's accounting.
+double thread_cpu_seconds();
+
 // A run that never happened because the engine cannot model the scene.
 RunRecord unsupported_run(const Scene& scene, const EngineInfo& info, const std::vector<std::string>& missing);
 

@@ -19,6 +19,13 @@ struct ScenarioResult {
   Reference reference;
   std::vector<RunRecord> runs;
   std::vector<PairComparison> pairs;
+  // Harness accounting, thread CPU seconds (`physval run --overhead FILE`): the
+  // reference (computed, or read from the cache) with its children; compare_run and
+  // compare_pair; writing this scenario's series and its part of results.json (filled by
+  // write_results, which takes the result as const: hence mutable).
+  double reference_cpu_seconds = 0.0;
+  double compare_cpu_seconds = 0.0;
+  mutable double write_cpu_seconds = 0.0;
 };
 
 struct SuiteResult {
