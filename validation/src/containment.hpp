@@ -74,7 +74,8 @@ class ContainmentMonitor {
   // (body, barrier segment) -> the side a body came from when it landed within eps of
   // the segment's line: leaving to the other side later is a crossing too.
   std::unordered_map<std::uint64_t, signed char> on_line_;
-  std::vector<Vec2> previous_;
+  std::vector<Vec2> previous_, previous_velocity_;
+  double previous_time_ = 0.0;
   std::vector<char> previous_alive_, escaped_;
   ContainmentRecord record_;
 };
