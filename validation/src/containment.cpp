@@ -254,7 +254,9 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
       // the straight path of one centre relative to the other, from the step before to now
       // (a 300 m/s ball through a resting one in one step is at neither end inside it),
       // when both steps were straight (neither body met anything in it), each bend added.
-      const double smaller = std::min(radius(i), radius(j));
+      // A point (radius 0) has passed into a circle when it gets half-way to its centre.
+      const double smaller = std::min(radius(i), radius(j)) > 0.0 ? std::min(radius(i), radius(j))
+                                                                   : 0.5 * std::max(radius(i), radius(j));
       double closest = radius(i) + radius(j) - depth;
       if (const double off = bend(i) + bend(j); off < 0.5 * smaller) {
         const Vec2 d0 = before(i) - before(j), dd = (xi - position(j)) - d0;

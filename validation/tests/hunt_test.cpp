@@ -12,6 +12,7 @@
 #include "physval/validation/comparator.hpp"
 #include "physval/validation/conservation.hpp"
 #include "physval/validation/runner.hpp"
+#include "physval/validation/scenario_loader.hpp"
 
 namespace physval {
 namespace {
@@ -35,17 +36,21 @@ BodyDef circle(const std::string& name, Vec2 at, double radius, double mass) {
 // line. Physics: it bounces back (mass ratio 0.01: v' = -0.98 v). Bullet, Chipmunk and ODE
 // (no continuous collision between moving bodies) and Box2D below its speed clamp let it
 // through within one step; its centre was never inside the target at a step's end, so
-// escaped_bodies stayed 0, energy and momentum are untouched, and each run was `ok`.
+// escaped_bodies stayed 0, energy and momentum are untouched, and each run was `ok`. A
+// point (radius 0) was never an escape from a moving ball at all, even ending inside it
+// (Chipmunk lets a 30 m/s point through; a static ball caught the same pass).
 // Oracle: a ball that ends beyond the target went through it.
 TEST(Hunt, AFastBallThroughAMovingBallWithinOneStepIsAnEscape) {
   int passed_through = 0, runs = 0;
+  for (double shot_radius : {0.05, 0.0}) {
   for (double dt : {1.0 / 60.0, 1.0 / 30.0}) {
-    for (double speed : {60.0, 100.0, 150.0, 300.0}) {
+    for (double speed : {30.0, 60.0, 100.0, 150.0, 300.0}) {
       Scene s;
       s.name = "through_a_ball";
       s.dt = dt;
       s.duration = 0.5;
-      BodyDef shot = circle("shot", {-3.0, 0.0}, 0.05, 0.01);
+      BodyDef shot = circle("shot", {-3.0, 0.0}, shot_radius, 0.01);
+      if (shot_radius == 0.0) shot.shape = ShapeKind::Point;
       shot.velocity = {speed, 0.0};
       s.bodies = {shot, circle("target", {0.0, 0.0}, 0.5, 1.0)};
       for (const EngineFactory& f : engine_registry()) {
@@ -53,7 +58,8 @@ TEST(Hunt, AFastBallThroughAMovingBallWithinOneStepIsAnEscape) {
         const RunRecord r = run_and_compare(s, f);
         if (r.status == RunStatus::Error) continue;
         ++runs;
-        const std::string where = f.info.name + " dt " + std::to_string(dt) + " v " + std::to_string(speed);
+        const std::string where = f.info.name + " r " + std::to_string(shot_radius) + " dt " + std::to_string(dt) +
+                                  " v " + std::to_string(speed);
         const bool through = r.final_states[0].position.x > r.final_states[1].position.x;
         ASSERT_TRUE(r.metrics.at("escaped_bodies").has_value()) << where;
         if (through) {
@@ -68,6 +74,7 @@ TEST(Hunt, AFastBallThroughAMovingBallWithinOneStepIsAnEscape) {
         }
       }
     }
+  }
   }
   EXPECT_GT(runs, 8);
   EXPECT_GT(passed_through, 0);   // the grid reaches the engines' pass-through (else it shows nothing)
@@ -138,6 +145,87 @@ TEST(Hunt, APointStartingOnAFloorWithinRoundOffThatFallsThroughIsAnEscape) {
     if (r.status == RunStatus::Error) continue;
     EXPECT_EQ(*r.metrics.at("escaped_bodies"), 0.0) << f.info.name;
     EXPECT_EQ(r.status, RunStatus::Ok) << f.info.name << ": " << r.reason;
+  }
+}
+
+// Finding 2b. A point exactly on a floor's line (to round-off) is on neither side of a
+// zero-thickness barrier: at rest there, core kept it on the floor and Box2D, Bullet,
+// Chipmunk and ODE let it fall through; moving down, all five let it through; every run
+// `ok`, and no containment rule can say which side it started on. It is bad input now
+// (file:line:col and key, like an overlap); 1e-9 m above the floor it loads and runs.
+TEST(Hunt, APointOnABarriersLineIsRefusedWithFileLineAndKey) {
+  auto text = [](const std::string& y, const std::string& extra) {
+    return "name = \"p\"\nduration = 1.0\n" + extra + "[world]\ngravity = [0.0, -9.81]\n[[bodies]]\nname = \"p\"\n"
+           "shape = \"point\"\nposition = [0.5, " + y + "]\n[[walls]]\nname = \"floor\"\nfrom = [-5.0, 0.0]\n"
+           "to = [5.0, 0.0]\n";
+  };
+  for (const char* y : {"0.0", "1e-15", "-1e-12"}) {
+    const ScenarioLoad l = parse_scenario(text(y, ""), "on.toml");
+    EXPECT_FALSE(l.scene.has_value()) << y;
+    ASSERT_EQ(l.errors.size(), 1u) << y;
+    EXPECT_EQ(l.errors[0].line, 8) << y;   // position = ...
+    EXPECT_EQ(l.errors[0].key, "bodies[0].position") << y;
+    EXPECT_NE(l.errors[0].message.find("a point on wall \"floor\""), std::string::npos) << l.errors[0].str();
+  }
+  EXPECT_TRUE(parse_scenario(text("1e-9", ""), "above.toml").scene.has_value());
+  EXPECT_TRUE(parse_scenario(text("0.0", "allow_initial_overlap = true\n"), "meant.toml").scene.has_value());
+  // Beyond the wall's end the line is no barrier.
+  EXPECT_TRUE(parse_scenario(text("0.0", "").replace(text("0.0", "").find("[0.5, 0.0]"), 10, "[6.0, 0.0]"), "past.toml")
+                  .scene.has_value());
+}
+
+// Finding 3. A ball dropped 10 m onto a floor: the same motion whatever the floor's width,
+// but the energy scale was M |g| x the scene's diagonal, so a 2 km floor made every energy
+// drift 200x smaller. Box2D gains 2% of the ball's energy per bounce (apex 10.21 m): its
+// energy_drift read 1.7e-2 on a 2 m floor (a gate of 1e-2 failed it) and 1.6e-5 on a 20 km
+// one (the same gate passed it). Oracle: the drift of the run's own energies over
+// m g H, H = 10.5 m the scene's extent along g (floor to the ball's top), whatever the width.
+TEST(Hunt, EnergyDriftDoesNotShrinkWithAWiderFloor) {
+  int runs = 0;
+  for (double half_width : {1.0, 5.0, 100.0, 10000.0}) {
+    Scene s;
+    s.name = "wide_floor";
+    s.dt = 1.0 / 60.0;
+    s.duration = 4.5;
+    s.world.gravity = {0.0, -9.8};
+    s.bodies = {circle("ball", {0.0, 10.0}, 0.5, 2.0)};
+    WallDef floor;
+    floor.name = "floor";
+    floor.from = {-half_width, 0.0};
+    floor.to = {half_width, 0.0};
+    s.walls = {floor};
+    const double scale = 2.0 * 9.8 * 10.5;
+    for (const EngineFactory& f : engine_registry()) {
+      if (!unsupported_features(f.info, s).empty()) continue;
+      const RunRecord r = run_and_compare(s, f);
+      if (r.status == RunStatus::Error) continue;
+      ++runs;
+      double drift = 0.0;
+      for (const Totals& t : r.series.totals) drift = std::max(drift, std::abs(t.energy() - r.series.totals[0].energy()));
+      drift /= scale;
+      ASSERT_TRUE(r.metrics.at("energy_drift").has_value()) << f.info.name;
+      EXPECT_NEAR(*r.metrics.at("energy_drift"), drift, 1e-12 + 1e-9 * drift) << f.info.name << " floor half-width "
+                                                                             << half_width;
+    }
+  }
+  EXPECT_GT(runs, 8);
+}
+
+// Core bugs the hunt found (core/ belongs to other helpers; reported, not fixed here). Each
+// scene's [expect] is its closed form and core misses it today: enable when core is fixed.
+// v_trough_inelastic: an e = 0 ball meeting both faces of a V at once is resolved face after
+// face in wall order and leaves sideways (symmetry broken; every other engine stops it).
+// point_on_floor_exact: a point starting exactly on a floor, moving into it, falls through.
+TEST(Hunt, DISABLED_CoreMeetsTheClosedFormsOfTheHuntsCoreRepros) {
+  const EngineFactory* core = reference_engine();
+  ASSERT_NE(core, nullptr);
+  for (const char* file : {"v_trough_inelastic.toml", "point_on_floor_exact.toml"}) {
+    const ScenarioLoad l = load_scenario_file(std::string(PHYSVAL_SOURCE_DIR) + "/validation/tests/hunt/" + file);
+    ASSERT_TRUE(l.scene.has_value()) << file;
+    const RunRecord r = run_and_compare(*l.scene, *core);
+    EXPECT_EQ(r.status, RunStatus::Ok) << file << ": " << r.reason;
+    ASSERT_TRUE(r.metrics.at("expectation_failures").has_value()) << file;
+    EXPECT_EQ(*r.metrics.at("expectation_failures"), 0.0) << file;
   }
 }
 
