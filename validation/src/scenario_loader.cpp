@@ -719,7 +719,20 @@ void check_references(Context& ctx, const toml::table& root, Scene& s) {
     check(body_exists(s.expect.final_states[i].body), indexed("expect.final", i) + ".body", s.expect.final_states[i].body, "body");
   }
   for (std::size_t i = 0; i < s.expect.apex.size(); ++i) {
-    check(body_exists(s.expect.apex[i].body), indexed("expect.apex", i) + ".body", s.expect.apex[i].body, "body");
+    const ExpectedApex& a = s.expect.apex[i];
+    check(body_exists(a.body), indexed("expect.apex", i) + ".body", a.body, "body");
+    // The highest y includes the start: a body expected to come back up to where it
+    // started meets that at t = 0 whatever the run does (an engine whose ball never bounced
+    // passed `apex = 10 m` for a 10 m drop). Without its time such an apex checks nothing
+    // (with it, the t = 0 start holds the maximum unless the run climbs past it).
+    const int b = s.body_index(a.body);
+    const double tolerance = a.tolerance.value_or(1e-3);
+    if (b >= 0 && !a.time && std::abs(s.bodies[static_cast<std::size_t>(b)].position.y - a.height) <= tolerance) {
+      ctx.error(expect_where(), indexed("expect.apex", i) + ".height",
+                "\"" + a.body + "\" starts at y = " + format_number(s.bodies[static_cast<std::size_t>(b)].position.y) +
+                    " m, within the tolerance of this height: the highest y is met at t = 0 whatever the run does; "
+                    "hold the bounce with `contacts` times or a `final` state instead");
+    }
   }
   for (std::size_t i = 0; i < s.expect.period.size(); ++i) {
     check(body_exists(s.expect.period[i].body), indexed("expect.period", i) + ".body", s.expect.period[i].body, "body");

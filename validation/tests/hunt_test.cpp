@@ -174,6 +174,31 @@ TEST(Hunt, APointOnABarriersLineIsRefusedWithFileLineAndKey) {
                   .scene.has_value());
 }
 
+// Finding 4. `apex` is the highest y reached, the start included: a ball dropped from 10 m
+// and expected to bounce back to 10 m met it at t = 0 whatever the run did. ODE with a
+// bounce threshold (the ball stopped dead on the floor, half the energy gone) passed
+// `apex = [{ body = "ball", height = 10.0 }]`, exit 0. Such an apex is bad input now.
+TEST(Hunt, AnApexTheStartAlreadyMeetsIsRefused) {
+  auto text = [](const std::string& apex) {
+    return "name = \"drop\"\nduration = 4.0\n[world]\ngravity = [0.0, -9.81]\n[[bodies]]\nname = \"ball\"\n"
+           "radius = 0.5\nposition = [0.0, 10.0]\n[[walls]]\nname = \"floor\"\nfrom = [-5.0, -0.5]\n"
+           "to = [5.0, -0.5]\n[expect]\napex = [ " + apex + " ]\n";
+  };
+  for (const char* apex : {"{ body = \"ball\", height = 10.0 }", "{ body = \"ball\", height = 10.0005 }",
+                           "{ body = \"ball\", height = 9.9, tolerance = 0.2 }"}) {
+    const ScenarioLoad l = parse_scenario(text(apex), "drop.toml");
+    EXPECT_FALSE(l.scene.has_value()) << apex;
+    ASSERT_EQ(l.errors.size(), 1u) << apex;
+    EXPECT_EQ(l.errors[0].key, "expect.apex[0].height") << l.errors[0].str();
+    EXPECT_EQ(l.errors[0].str().rfind("drop.toml:", 0), 0u) << l.errors[0].str();
+  }
+  // Above the start (a ball thrown up), with its time, or out of the tolerance: it can fail.
+  for (const char* apex : {"{ body = \"ball\", height = 12.0 }", "{ body = \"ball\", height = 10.0, time = 2.9 }",
+                           "{ body = \"ball\", height = 9.0 }"}) {
+    EXPECT_TRUE(parse_scenario(text(apex), "drop.toml").scene.has_value()) << apex;
+  }
+}
+
 // Finding 3. A ball dropped 10 m onto a floor: the same motion whatever the floor's width,
 // but the energy scale was M |g| x the scene's diagonal, so a 2 km floor made every energy
 // drift 200x smaller. Box2D gains 2% of the ball's energy per bounce (apex 10.21 m): its
