@@ -57,28 +57,13 @@ double inf_norm(Vec2 v) { return std::max(std::fabs(v.x), std::fabs(v.y)); }
 
 class EventLoop {
  public:
-  EventLoop(World& w, StepContext& ctx) : w_(w), ctx_(ctx), T_(ctx.dt) {}
+  EventLoop(World& w, StepContext& ctx) : w_(w), ctx_(ctx), T_(ctx.dt), coupled_(w.coupled()) {}
 
   void run() {
     prune_passing(w_);
     w_.events.start(T_);
-    const std::size_t n = w_.size();
-    std::span<Aabb> boxes = w_.bp->prepare(n);
-    w_.active.resize(n);
-    for (std::uint32_t i = 0; i < n; ++i) {
-      w_.active[i] = w_.alive(i) ? 1 : 0;
-      if (w_.active[i]) boxes[i] = path_box(w_, i, 0.0, T_);
-    }
-    w_.bp->build(w_.active);
-    w_.pairs.clear();
-    w_.bp->pairs(w_.pairs);
+    schedule_all(0.0);
     w_.stats.candidate_pairs = static_cast<std::int64_t>(w_.pairs.size());
-    for (const BodyPair& p : w_.pairs) schedule_pair(p.a, p.b, 0.0);
-    for (std::uint32_t i = 0; i < n; ++i) {
-      if (!w_.dynamic(i)) continue;
-      schedule_statics(i, 0.0, w_.bp->box(i));
-      schedule_body(i, 0.0);
-    }
     if (!w_.emitters.empty()) {
       w_.scratch_events.clear();
       schedule_explosions(w_, ctx_, w_.scratch_events);
@@ -98,12 +83,68 @@ class EventLoop {
         return;
       }
       ++ctx_.events;
-      process(e);
+      if (coupled_) {
+        process_coupled(e);
+      } else {
+        process(e);
+      }
     }
   }
 
  private:
   void push(const Event& e) { w_.events.push(e); }
+
+  // Every body's path registered with the broad phase from t, and its events found.
+  void schedule_all(double t) {
+    const std::size_t n = w_.size();
+    std::span<Aabb> boxes = w_.bp->prepare(n);
+    w_.active.resize(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      w_.active[i] = w_.alive(i) ? 1 : 0;
+      if (w_.active[i]) boxes[i] = path_box(w_, i, t, T_);
+    }
+    w_.bp->build(w_.active);
+    w_.pairs.clear();
+    w_.bp->pairs(w_.pairs);
+    for (const BodyPair& p : w_.pairs) schedule_pair(p.a, p.b, t);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      if (!w_.dynamic(i)) continue;
+      schedule_statics(i, t, w_.bp->box(i));
+      schedule_body(i, t);
+    }
+  }
+
+  // Newtonian gravity (w.coupled()): an event that changes a path cuts the step of the
+  // whole system (substeps.cpp). Its time is refined on the system's integrator step,
+  // every free body is put at its state there, the event is processed as usual, and
+  // the system's next sub-step starts there: new paths, every body's events found
+  // again (the old ones go stale with a new version).
+  void process_coupled(Event e) {
+    bool cuts = e.kind() != EventKind::Emit;
+    if (e.kind() == EventKind::Pair) {
+      if (w_.response(w_.group[e.a], w_.group[e.b]).collide) {
+        e.time = refine_coupled_pair(w_, e.a, e.b, e.time, std::max(w_.tloc[e.a], w_.tloc[e.b]), T_);
+      } else {
+        cuts = false;   // passes through: no path changes
+      }
+    } else if (e.kind() == EventKind::Static) {
+      const Segment& seg = w_.statics.segments[e.b];
+      if (w_.response(w_.group[e.a], seg.group).collide) {
+        e.time = refine_coupled_static(w_, e.a, seg, e.feature() != 0, e.time, w_.tloc[e.a], T_);
+      } else {
+        cuts = false;
+      }
+    }
+    if (!cuts) {
+      process(e);
+      return;
+    }
+    coupled_cut(w_, e.time);
+    process(e);
+    coupled_restart(w_, e.time, T_);
+    for (std::uint32_t i = 0; i < w_.size(); ++i) ++w_.version[i];
+    schedule_all(e.time);
+  }
 
   // Asks for the memory the next event will read while this one is processed.
   void prefetch(const Event& e) const {
@@ -620,6 +661,7 @@ class EventLoop {
   World& w_;
   StepContext& ctx_;
   const double T_;
+  const bool coupled_;   // Newtonian gravity: events cut the whole system's step
   std::vector<std::uint32_t> set_;      // the touching set of a simultaneous impact
   std::vector<BodyPair> impacted_;      // its pairs that took an impulse
   std::vector<std::uint32_t> near_;     // bodies near one being held
