@@ -432,6 +432,7 @@ void compare_run(RunRecord& run, const Scene& scene, const Reference& reference,
   const Conserved conserved = conserved_quantities(scene);
   const Scales scales = characteristic_scales(scene, reference.run ? &reference.run->series : nullptr);
   const Series& s = run.series;
+  bool energy_diverged = false;   // the run's status came from its energy (below)
   if (!s.totals.empty()) {
     const Totals& t0 = s.totals.front();
     double de = 0.0, dp = 0.0, dl = 0.0, gain = 0.0;
@@ -452,6 +453,7 @@ void compare_run(RunRecord& run, const Scene& scene, const Reference& reference,
     if (conserved.linear_momentum) run.metrics["linear_momentum_drift"] = dp;
     if (conserved.angular_momentum) run.metrics["angular_momentum_drift"] = dl;
     if (runaway_at && run.status == RunStatus::Ok) {
+      energy_diverged = true;
       run.status = RunStatus::Diverged;
       run.diverged_at = runaway_at;
       run.reason = "energy ran away: it changed by " + fmt(de) + " x the scene's energy scale";
@@ -460,6 +462,7 @@ void compare_run(RunRecord& run, const Scene& scene, const Reference& reference,
     // without a reference: a reference of a chaotic pile does not converge, and an engine
     // whose bodies fly apart must still not be ok.
     if (gain_at && run.status == RunStatus::Ok) {
+      energy_diverged = true;
       run.status = RunStatus::Diverged;
       run.diverged_at = gain_at;
       run.reason = "energy grew by " + fmt(gain) + " x the scene's energy scale in a scene that can only lose it "
@@ -478,6 +481,7 @@ void compare_run(RunRecord& run, const Scene& scene, const Reference& reference,
     run.metrics["linear_momentum_divergence"] = d.momentum_max;
     run.metrics["linear_momentum_divergence_rms"] = d.momentum_rms;
     if (d.first_energy_excess_time && run.status == RunStatus::Ok && !conserved.energy) {
+      energy_diverged = true;
       run.status = RunStatus::Diverged;
       run.diverged_at = d.first_energy_excess_time;
       run.reason = "energy ran away from the reference by more than 10 x the scene's energy scale";
@@ -509,12 +513,17 @@ void compare_run(RunRecord& run, const Scene& scene, const Reference& reference,
     const ContainmentRecord& c = run.containment;
     run.metrics["max_penetration"] = c.max_penetration;
     if (c.escaped_bodies) run.metrics["escaped_bodies"] = *c.escaped_bodies;
-    if (c.escaped_bodies && *c.escaped_bodies > 0 && run.status == RunStatus::Ok) {
+    // An escape no later than an energy divergence is the run's divergence (a body fallen
+    // through a floor keeps falling: its energy error grows past the scene's scale after).
+    const bool escaped_first = energy_diverged && c.first_escape_time && run.diverged_at &&
+                               *c.first_escape_time <= *run.diverged_at;
+    if (c.escaped_bodies && *c.escaped_bodies > 0 && (run.status == RunStatus::Ok || escaped_first)) {
+      const std::string then = escaped_first ? "; then " + run.reason : "";
       run.status = RunStatus::Diverged;
       run.diverged_at = c.first_escape_time;
       run.reason = std::to_string(*c.escaped_bodies) + " of " + std::to_string(scene.bodies.size()) +
                    " bodies passed through a barrier (first " + c.first_escape + " at t = " +
-                   fmt(c.first_escape_time.value_or(0.0)) + " s)";
+                   fmt(c.first_escape_time.value_or(0.0)) + " s)" + then;
       if (auto known = scene.gate.known_failures.find(run.engine); known != scene.gate.known_failures.end()) {
         if (auto k = known->second.find("escaped_bodies"); k != known->second.end()) {
           run.known_divergence = *c.escaped_bodies <= k->second;

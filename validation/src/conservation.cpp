@@ -142,6 +142,23 @@ Scales characteristic_scales(const Scene& scene, const Series* motion) {
   for (const BoxDef& b : scene.boxes) { extend(b.min, 0.0); extend(b.max, 0.0); }
   for (const SurfaceDef& sf : scene.surfaces) for (Vec2 p : sf.points) extend(p, 0.0);
   s.length = hi.x >= lo.x ? std::max(length(hi - lo), 1e-9) : 1.0;
+  // The field's potential energy spans M |g| times the scene's extent along the field, not
+  // its diagonal: a ball dropped 10 m onto a floor 2 km wide must not have a 200x larger
+  // energy scale (and 200x smaller drifts) than on a floor 2 m wide.
+  const double g_norm = length(scene.world.gravity);
+  const Vec2 down = g_norm > 0.0 ? scene.world.gravity / g_norm : Vec2{0.0, 0.0};
+  double h_lo = 1e300, h_hi = -1e300;
+  auto extend_h = [&](Vec2 p, double r) {
+    h_lo = std::min(h_lo, dot(p, down) - r);
+    h_hi = std::max(h_hi, dot(p, down) + r);
+  };
+  for (const BodyDef& b : scene.bodies) extend_h(b.position, b.radius);
+  for (const WallDef& w : scene.walls) { extend_h(w.from, 0.0); extend_h(w.to, 0.0); }
+  for (const BoxDef& b : scene.boxes) {
+    for (Vec2 c : {b.min, b.max, Vec2{b.min.x, b.max.y}, Vec2{b.max.x, b.min.y}}) extend_h(c, 0.0);
+  }
+  for (const SurfaceDef& sf : scene.surfaces) for (Vec2 p : sf.points) extend_h(p, 0.0);
+  double height = h_hi >= h_lo ? h_hi - h_lo : 0.0;
 
   double mass = 0.0, ke = 0.0, p = 0.0, l = 0.0;
   for (const BodyDef& b : scene.bodies) {
@@ -169,13 +186,15 @@ Scales characteristic_scales(const Scene& scene, const Series* motion) {
       pe_max = std::max(pe_max, motion->totals[k].potential);
       const auto& st = motion->states[k];
       for (std::size_t i = 0; i < st.size() && i < scene.bodies.size(); ++i) {
-        if (st[i].alive) travel = std::max(travel, length(st[i].position - scene.bodies[i].position));
+        if (!st[i].alive) continue;
+        travel = std::max(travel, length(st[i].position - scene.bodies[i].position));
+        height = std::max(height, std::abs(dot(st[i].position - scene.bodies[i].position, down)));
       }
     }
     s.length = std::max(s.length, travel);
     motion_energy = ke_max + (pe_max - pe_min) + u;
   }
-  s.energy = std::max(ke + mass * length(scene.world.gravity) * s.length + u, motion_energy);
+  s.energy = std::max(ke + mass * g_norm * height + u, motion_energy);
   if (!(s.energy > 0.0)) s.energy = 1.0;   // nothing moves and nothing pulls: 1 J
   s.momentum = std::max(p, std::sqrt(2.0 * mass * s.energy));
   if (!(s.momentum > 0.0)) s.momentum = 1.0;

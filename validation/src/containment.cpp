@@ -179,11 +179,29 @@ void ContainmentMonitor::penetration(double depth, double t, const std::string& 
 void ContainmentMonitor::start(const std::vector<BodyState>& states) {
   const std::size_t nb = std::min(states.size(), scene_.bodies.size());
   previous_.assign(scene_.bodies.size(), Vec2{});
+  previous_velocity_.assign(scene_.bodies.size(), Vec2{});
+  previous_time_ = 0.0;
   previous_alive_.assign(scene_.bodies.size(), 0);
   escaped_.assign(scene_.bodies.size(), 0);
   for (std::size_t i = 0; i < nb; ++i) {
     previous_[i] = states[i].position;
+    previous_velocity_[i] = states[i].velocity;
     previous_alive_[i] = states[i].alive ? 1 : 0;
+  }
+  // A body that starts within eps of a segment's line (a point put on a floor up to
+  // round-off) is on the side its offset says: leaving the line to the other side later is
+  // a crossing, as for one that landed there. Exactly on the line says no side; left out.
+  for (std::size_t i : moving_) {
+    if (i >= nb || !states[i].alive) continue;
+    const Vec2 p = states[i].position;
+    for (std::size_t k = 0; k < barriers_.size(); ++k) {
+      const Barrier& b = barriers_[k];
+      if (b.circle || !blocks_[body_group_[i]][b.group]) continue;
+      const double d = cross(b.dir, p - b.a), u = dot(p - b.a, b.dir);
+      if (d != 0.0 && std::abs(d) <= eps_ && u >= -eps_ && u <= b.len + eps_) {
+        on_line_[static_cast<std::uint64_t>(i) * barriers_.size() + k] = static_cast<signed char>(d > 0.0 ? 1 : -1);
+      }
+    }
   }
   order_ = moving_;
   lo_.assign(scene_.bodies.size(), 0.0);
@@ -196,16 +214,30 @@ void ContainmentMonitor::start(const std::vector<BodyState>& states) {
 
 void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states) {
   const std::size_t nb = std::min(states.size(), scene_.bodies.size());
-  // The moving bodies' positions, left ends and liveness, read once into compact arrays.
+  // Where body i was after the step before (its position now if it just appeared).
+  auto before = [&](std::size_t i) { return previous_alive_[i] ? previous_[i] : pos_[i]; };
+  // The moving bodies' positions, liveness and the left ends of their boxes swept over the
+  // step, read once into compact arrays.
   for (const std::size_t i : moving_) {
     const Vec2 x = i < nb ? states[i].position : scene_.bodies[i].position;
     pos_[i] = x;
-    lo_[i] = x.x - radius_[i];
     alive_[i] = i < nb && states[i].alive && is_finite(states[i].position);
+    lo_[i] = std::min(x.x, before(i).x) - radius_[i];
   }
+  // How far body i's step strays from the straight line its own velocities give (x0 + v0 h,
+  // x0 + v1 h, or their mean: explicit, semi-implicit Euler, Verlet): 0 for a body that
+  // met nothing in the step, large for one that bounced. Only a straight step's chord is
+  // its path.
+  const double h = t - previous_time_;
+  auto bend = [&](std::size_t i) {
+    if (!previous_alive_[i] || i >= nb) return 0.0;
+    const Vec2 dx = pos_[i] - previous_[i], v0 = previous_velocity_[i], v1 = states[i].velocity;
+    return std::min({length(dx - v0 * h), length(dx - v1 * h), length(dx - (v0 + v1) * (0.5 * h))});
+  };
 
-  // Moving pairs: a sweep over x, the order kept from the step before (insertion sort
-  // is linear on an almost sorted list).
+  // Moving pairs: a sweep over x of each body's box swept over the step (a pair that
+  // passed right through each other within one step overlaps there, not at its ends), the
+  // order kept from the step before (insertion sort is linear on an almost sorted list).
   for (std::size_t p = 1; p < order_.size(); ++p) {
     const std::size_t v = order_[p];
     const double key = lo_[v];
@@ -216,42 +248,61 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
     }
     order_[q] = v;
   }
-  // The sweep reads the bodies in x order from arrays laid out in that order.
+  // The sweep reads the bodies in x order from arrays laid out in that order: left ends,
+  // and the y interval the centre swept (NaN for a body that is not alive).
   const std::size_t n = order_.size();
   sorted_lo_.resize(n);
-  sorted_y_.resize(n);
+  sorted_ylo_.resize(n);
+  sorted_yhi_.resize(n);
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t p = 0; p < n; ++p) {
     const std::size_t i = order_[p];
     sorted_lo_[p] = lo_[i];
-    // A body that is not alive is never paired: NaN fails every comparison below.
-    sorted_y_[p] = alive_[i] ? pos_[i].y : std::numeric_limits<double>::quiet_NaN();
+    const double y0 = before(i).y, y1 = pos_[i].y;
+    sorted_ylo_[p] = alive_[i] ? std::min(y0, y1) : kNaN;
+    sorted_yhi_[p] = alive_[i] ? std::max(y0, y1) : kNaN;
   }
   for (std::size_t p = 0; p < n; ++p) {
     const std::size_t i = order_[p];
     if (!alive_[i]) continue;
     const Vec2 xi = pos_[i];
     const double ri = radius_[i];
-    const double hi = xi.x + ri;
+    const double hi = std::max(xi.x, before(i).x) + ri;
+    const double ylo = sorted_ylo_[p], yhi = sorted_yhi_[p];
     const std::size_t gi = body_group_[i] * n_body_groups_;
     for (std::size_t q = p + 1; q < n && sorted_lo_[q] <= hi; ++q) {
-      // Farther apart in y than the radii together could be (max_radius_ bounds rj) or
-      // not alive (NaN): skipped without touching anything else of j.
-      if (!(std::fabs(xi.y - sorted_y_[q]) <= (ri + max_radius_) * (1.0 + 1e-9))) continue;
+      // The swept y intervals farther apart than the radii together could be (max_radius_
+      // bounds rj) or j not alive (NaN): skipped without touching anything else of j.
+      const double reach = (ri + max_radius_) * (1.0 + 1e-9);
+      if (!(sorted_ylo_[q] <= yhi + reach && sorted_yhi_[q] >= ylo - reach)) continue;
       const std::size_t j = order_[q];
       const double rj = radius_[j];
-      const Vec2 xj = pos_[j];
-      // Farther apart in y than the radii together (with a margin far above rounding):
-      // the distance is too, the depth below is negative and nothing below can happen.
-      if (std::fabs(xi.y - xj.y) > (ri + rj) * (1.0 + 1e-9)) continue;
+      // The same with j's own radius (a margin far above rounding): the centres stayed
+      // farther apart in y than the radii together all step long, so nothing below happens.
+      const double reach_j = (ri + rj) * (1.0 + 1e-9);
+      if (sorted_ylo_[q] > yhi + reach_j || sorted_yhi_[q] < ylo - reach_j) continue;
       if (!pair_collides_[gi + body_group_[j]]) continue;
+      const Vec2 xj = pos_[j];
       const double depth = ri + rj - length(xi - xj);
       if (depth > record_.max_penetration) {
         penetration(depth, t, scene_.bodies[std::min(i, j)].name + " / " + scene_.bodies[std::max(i, j)].name);
       }
       // Passed into each other: the centres closer than the smaller radius (each centre
       // inside the other body; overlap deeper than the larger radius). No solver's slop
-      // comes near it: the pair has gone through, or is on its way.
-      if (depth > std::max(ri, rj) + eps_ && std::min(ri, rj) > 0.0) {
+      // comes near it: the pair has gone through, or is on its way. Judged along the step:
+      // the straight path of one centre relative to the other, from the step before to now
+      // (a 300 m/s ball through a resting one in one step is at neither end inside it),
+      // when both steps were straight (neither body met anything in it), each bend added.
+      // A point (radius 0) has passed into a circle when it gets half-way to its centre.
+      const double smaller = std::min(ri, rj) > 0.0 ? std::min(ri, rj) : 0.5 * std::max(ri, rj);
+      double closest = ri + rj - depth;
+      if (const double off = bend(i) + bend(j); off < 0.5 * smaller) {
+        const Vec2 d0 = before(i) - before(j), dd = (xi - xj) - d0;
+        const double len2 = dot(dd, dd);
+        const double u = len2 > 0.0 ? std::clamp(-dot(d0, dd) / len2, 0.0, 1.0) : 1.0;
+        closest = std::min(closest, length(d0 + dd * u) + off);
+      }
+      if (closest < smaller - eps_ && smaller > 0.0) {
         for (const std::size_t k : {i, j}) {
           if (escaped_[k]) continue;
           escaped_[k] = 1;
@@ -348,8 +399,10 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
       }
     }
     previous_[i] = p1;
+    previous_velocity_[i] = states[i].velocity;
     previous_alive_[i] = 1;
   }
+  previous_time_ = t;
 }
 
 }  // namespace physval

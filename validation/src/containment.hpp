@@ -63,10 +63,11 @@ class ContainmentMonitor {
   // Per scene body, filled once (radius) or at each observe (the rest): compact arrays
   // the sweep reads instead of the scene's BodyDefs and the engine's BodyStates.
   std::vector<double> radius_;
-  std::vector<double> lo_;                  // position.x - radius
+  std::vector<double> lo_;                  // left end of the box swept over the step
   std::vector<Vec2> pos_;
   std::vector<char> alive_;
-  std::vector<double> sorted_lo_, sorted_y_;   // lo_ and y (NaN: not alive) in order_'s order
+  // lo_ and the y interval swept over the step (NaN: not alive), in order_'s order
+  std::vector<double> sorted_lo_, sorted_ylo_, sorted_yhi_;
   double max_radius_ = 0.0;                    // of the moving bodies
   std::vector<std::uint32_t> on_line_count_;   // on_line_ entries of the body
   // Each barrier's bounding box, widened by 2 eps: a body's path whose box misses it
@@ -86,7 +87,8 @@ class ContainmentMonitor {
   // (body, barrier segment) -> the side a body came from when it landed within eps of
   // the segment's line: leaving to the other side later is a crossing too.
   std::unordered_map<std::uint64_t, signed char> on_line_;
-  std::vector<Vec2> previous_;
+  std::vector<Vec2> previous_, previous_velocity_;
+  double previous_time_ = 0.0;
   std::vector<char> previous_alive_, escaped_;
   ContainmentRecord record_;
 };

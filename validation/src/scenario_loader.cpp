@@ -719,7 +719,20 @@ void check_references(Context& ctx, const toml::table& root, Scene& s) {
     check(body_exists(s.expect.final_states[i].body), indexed("expect.final", i) + ".body", s.expect.final_states[i].body, "body");
   }
   for (std::size_t i = 0; i < s.expect.apex.size(); ++i) {
-    check(body_exists(s.expect.apex[i].body), indexed("expect.apex", i) + ".body", s.expect.apex[i].body, "body");
+    const ExpectedApex& a = s.expect.apex[i];
+    check(body_exists(a.body), indexed("expect.apex", i) + ".body", a.body, "body");
+    // The highest y includes the start: a body expected to come back up to where it
+    // started meets that at t = 0 whatever the run does (an engine whose ball never bounced
+    // passed `apex = 10 m` for a 10 m drop). Without its time such an apex checks nothing
+    // (with it, the t = 0 start holds the maximum unless the run climbs past it).
+    const int b = s.body_index(a.body);
+    const double tolerance = a.tolerance.value_or(1e-3);
+    if (b >= 0 && !a.time && std::abs(s.bodies[static_cast<std::size_t>(b)].position.y - a.height) <= tolerance) {
+      ctx.error(expect_where(), indexed("expect.apex", i) + ".height",
+                "\"" + a.body + "\" starts at y = " + format_number(s.bodies[static_cast<std::size_t>(b)].position.y) +
+                    " m, within the tolerance of this height: the highest y is met at t = 0 whatever the run does; "
+                    "hold the bounce with `contacts` times or a `final` state instead");
+    }
   }
   for (std::size_t i = 0; i < s.expect.period.size(); ++i) {
     check(body_exists(s.expect.period[i].body), indexed("expect.period", i) + ".body", s.expect.period[i].body, "body");
@@ -817,6 +830,33 @@ void check_initial_overlaps(Context& ctx, const toml::table& root, const Scene& 
       std::snprintf(text, sizeof text, "overlaps %s by %.3g m at t = 0", p.what->c_str(), depth);
       ctx.error(at != nullptr ? at->source() : root.source(), indexed("bodies", i) + ".position",
                 std::string(text) + " (set allow_initial_overlap = true at the top level if you mean it)");
+      ++reported;
+      break;
+    }
+  }
+  // A point on a barrier's line (to round-off): touching it, by the radius rule, but in a
+  // zero-thickness barrier it is on neither side, and each engine (core too) picks one: a
+  // point put on a floor at rest stayed on it in core and fell through it in the others,
+  // moving down it fell through in all five, every run `ok`.
+  for (std::size_t i = 0; i < s.bodies.size() && reported < 5; ++i) {
+    const BodyDef& d = s.bodies[i];
+    if (d.is_static || !(d.shape == ShapeKind::Point || !(d.radius > 0.0))) continue;
+    for (const Piece& p : pieces) {
+      const Vec2 ab = p.b - p.a;
+      const double len2 = dot(ab, ab);
+      const double u = len2 > 0.0 ? std::clamp(dot(d.position - p.a, ab) / len2, 0.0, 1.0) : 0.0;
+      const double gap = length(d.position - (p.a + ab * u));
+      const double roundoff = 1e-12 * (1.0 + length(d.position) + std::sqrt(len2));
+      if (gap > roundoff) continue;
+      if (!response_between(s, d.group, *p.group).collide) continue;
+      const toml::node* at = array != nullptr && i < array->size() ? array->get(i) : nullptr;
+      if (const auto* t = at != nullptr ? at->as_table() : nullptr; t != nullptr && t->get("position") != nullptr) {
+        at = t->get("position");
+      }
+      ctx.error(at != nullptr ? at->source() : root.source(), indexed("bodies", i) + ".position",
+                "a point on " + *p.what + " at t = 0 (" + format_number(gap) +
+                    " m from it): a point in a barrier is on neither side of it, and engines put it on either; "
+                    "start it off the line (or set allow_initial_overlap = true at the top level if you mean it)");
       ++reported;
       break;
     }

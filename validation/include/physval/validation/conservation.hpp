@@ -36,7 +36,7 @@ Conserved conserved_quantities(const Scene& scene);
 // of them can be near zero while the scene moves (a resting pile's energy can).
 struct Scales {
   double length = 1.0;            // m: the extent of bodies and barriers, or how far bodies travel
-  double energy = 1.0;            // J: max(KE0 + M |g| L + |U_newton(0)|, max KE + range of PE)
+  double energy = 1.0;            // J: max(KE0 + M |g| H + |U_newton(0)|, max KE + range of PE), H: extent along g
   double momentum = 1.0;          // kg m/s: max(sum m |v0|, sqrt(2 M E))
   double angular_momentum = 1.0;  // kg m^2/s: sum m |x0| |v0| + P L
 };

@@ -1,0 +1,258 @@
+// The hunt for wrong greens (branch hunt): scenes a user writes where physval said `ok`
+// (or a gate passed) while the physics was wrong. Each test runs real engines over a grid
+// and holds each run's verdict against an oracle computed here from the run's own final
+// state or from the closed form; each failed before its fix. scripts/hunt.sh reruns the
+// grids end to end through the physval command.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "physval/adapters/registry.hpp"
+#include "physval/validation/comparator.hpp"
+#include "physval/validation/conservation.hpp"
+#include "physval/validation/runner.hpp"
+#include "physval/validation/scenario_loader.hpp"
+
+namespace physval {
+namespace {
+
+RunRecord run_and_compare(const Scene& s, const EngineFactory& f) {
+  RunRecord r = run_engine(s, f, RunOptions{});
+  compare_run(r, s, Reference{}, false);
+  return r;
+}
+
+BodyDef circle(const std::string& name, Vec2 at, double radius, double mass) {
+  BodyDef b;
+  b.name = name;
+  b.radius = radius;
+  b.mass = mass;
+  b.position = at;
+  return b;
+}
+
+// Finding 1. A 5 cm, 10 g ball at 60-300 m/s meets a 0.5 m, 1 kg ball at rest, on one
+// line. Physics: it bounces back (mass ratio 0.01: v' = -0.98 v). Bullet, Chipmunk and ODE
+// (no continuous collision between moving bodies) and Box2D below its speed clamp let it
+// through within one step; its centre was never inside the target at a step's end, so
+// escaped_bodies stayed 0, energy and momentum are untouched, and each run was `ok`. A
+// point (radius 0) was never an escape from a moving ball at all, even ending inside it
+// (Chipmunk lets a 30 m/s point through; a static ball caught the same pass).
+// Oracle: a ball that ends beyond the target went through it.
+TEST(Hunt, AFastBallThroughAMovingBallWithinOneStepIsAnEscape) {
+  int passed_through = 0, runs = 0;
+  for (double shot_radius : {0.05, 0.0}) {
+  for (double dt : {1.0 / 60.0, 1.0 / 30.0}) {
+    for (double speed : {30.0, 60.0, 100.0, 150.0, 300.0}) {
+      Scene s;
+      s.name = "through_a_ball";
+      s.dt = dt;
+      s.duration = 0.5;
+      BodyDef shot = circle("shot", {-3.0, 0.0}, shot_radius, 0.01);
+      if (shot_radius == 0.0) shot.shape = ShapeKind::Point;
+      shot.velocity = {speed, 0.0};
+      s.bodies = {shot, circle("target", {0.0, 0.0}, 0.5, 1.0)};
+      for (const EngineFactory& f : engine_registry()) {
+        if (!unsupported_features(f.info, s).empty()) continue;
+        const RunRecord r = run_and_compare(s, f);
+        if (r.status == RunStatus::Error) continue;
+        ++runs;
+        const std::string where = f.info.name + " r " + std::to_string(shot_radius) + " dt " + std::to_string(dt) +
+                                  " v " + std::to_string(speed);
+        const bool through = r.final_states[0].position.x > r.final_states[1].position.x;
+        ASSERT_TRUE(r.metrics.at("escaped_bodies").has_value()) << where;
+        if (through) {
+          ++passed_through;
+          EXPECT_GE(*r.metrics.at("escaped_bodies"), 1.0) << where;
+          EXPECT_EQ(r.status, RunStatus::Diverged) << where << ": " << r.reason;
+          EXPECT_FALSE(r.passed()) << where;
+        }   // (one that went in and was pushed back out is an escape too: Box2D at 60 m/s)
+        if (f.info.name == "core") {
+          EXPECT_FALSE(through) << where;   // exact impacts: it bounces back
+          EXPECT_EQ(r.status, RunStatus::Ok) << where << ": " << r.reason;
+        }
+      }
+    }
+  }
+  }
+  EXPECT_GT(runs, 8);
+  EXPECT_GT(passed_through, 0);   // the grid reaches the engines' pass-through (else it shows nothing)
+}
+
+// Finding 2. A point that starts within round-off of a floor's line (1e-15 m or 1e-9 m
+// above it, inside the containment's eps) and falls through it: it never "landed" on the
+// line from a side, so leaving it downwards was no crossing, and Bullet's and Chipmunk's
+// runs, with the point 5 m below the floor, were `ok`. Oracle: final y below the floor.
+TEST(Hunt, APointStartingOnAFloorWithinRoundOffThatFallsThroughIsAnEscape) {
+  int fell = 0;
+  for (double y0 : {1e-15, 1e-12, 1e-9}) {
+    for (double vy : {0.0, -1.0}) {
+      Scene s;
+      s.name = "point_on_floor";
+      s.dt = 1.0 / 60.0;
+      s.duration = 1.0;
+      s.world.gravity = {0.0, -9.81};
+      BodyDef p;
+      p.name = "p";
+      p.shape = ShapeKind::Point;
+      p.radius = 0.0;
+      p.position = {0.0, y0};
+      p.velocity = {0.0, vy};
+      p.restitution = 0.0;
+      s.bodies = {p};
+      WallDef floor;
+      floor.name = "floor";
+      floor.from = {-5.0, 0.0};
+      floor.to = {5.0, 0.0};
+      s.walls = {floor};
+      for (const EngineFactory& f : engine_registry()) {
+        if (!unsupported_features(f.info, s).empty()) continue;
+        const RunRecord r = run_and_compare(s, f);
+        if (r.status == RunStatus::Error) continue;
+        const std::string where = f.info.name + " y0 " + std::to_string(y0) + " vy " + std::to_string(vy);
+        ASSERT_TRUE(r.metrics.at("escaped_bodies").has_value()) << where;
+        if (r.final_states[0].position.y < -1e-6) {
+          ++fell;
+          EXPECT_EQ(*r.metrics.at("escaped_bodies"), 1.0) << where;
+          EXPECT_EQ(r.status, RunStatus::Diverged) << where << ": " << r.reason;
+        } else {
+          EXPECT_EQ(*r.metrics.at("escaped_bodies"), 0.0) << where;
+        }
+      }
+    }
+  }
+  EXPECT_GT(fell, 0);
+  // A point that starts within round-off above a floor and leaves upwards crossed nothing.
+  Scene s;
+  s.name = "point_leaves_floor";
+  s.dt = 1.0 / 60.0;
+  s.duration = 0.5;
+  BodyDef p;
+  p.name = "p";
+  p.shape = ShapeKind::Point;
+  p.position = {0.0, 1e-12};
+  p.velocity = {0.3, 2.0};
+  s.bodies = {p};
+  WallDef floor;
+  floor.name = "floor";
+  floor.from = {-5.0, 0.0};
+  floor.to = {5.0, 0.0};
+  s.walls = {floor};
+  for (const EngineFactory& f : engine_registry()) {
+    if (!unsupported_features(f.info, s).empty()) continue;
+    const RunRecord r = run_and_compare(s, f);
+    if (r.status == RunStatus::Error) continue;
+    EXPECT_EQ(*r.metrics.at("escaped_bodies"), 0.0) << f.info.name;
+    EXPECT_EQ(r.status, RunStatus::Ok) << f.info.name << ": " << r.reason;
+  }
+}
+
+// Finding 2b. A point exactly on a floor's line (to round-off) is on neither side of a
+// zero-thickness barrier: at rest there, core kept it on the floor and Box2D, Bullet,
+// Chipmunk and ODE let it fall through; moving down, all five let it through; every run
+// `ok`, and no containment rule can say which side it started on. It is bad input now
+// (file:line:col and key, like an overlap); 1e-9 m above the floor it loads and runs.
+TEST(Hunt, APointOnABarriersLineIsRefusedWithFileLineAndKey) {
+  auto text = [](const std::string& y, const std::string& extra) {
+    return "name = \"p\"\nduration = 1.0\n" + extra + "[world]\ngravity = [0.0, -9.81]\n[[bodies]]\nname = \"p\"\n"
+           "shape = \"point\"\nposition = [0.5, " + y + "]\n[[walls]]\nname = \"floor\"\nfrom = [-5.0, 0.0]\n"
+           "to = [5.0, 0.0]\n";
+  };
+  for (const char* y : {"0.0", "1e-15", "-1e-12"}) {
+    const ScenarioLoad l = parse_scenario(text(y, ""), "on.toml");
+    EXPECT_FALSE(l.scene.has_value()) << y;
+    ASSERT_EQ(l.errors.size(), 1u) << y;
+    EXPECT_EQ(l.errors[0].line, 8) << y;   // position = ...
+    EXPECT_EQ(l.errors[0].key, "bodies[0].position") << y;
+    EXPECT_NE(l.errors[0].message.find("a point on wall \"floor\""), std::string::npos) << l.errors[0].str();
+  }
+  EXPECT_TRUE(parse_scenario(text("1e-9", ""), "above.toml").scene.has_value());
+  EXPECT_TRUE(parse_scenario(text("0.0", "allow_initial_overlap = true\n"), "meant.toml").scene.has_value());
+  // Beyond the wall's end the line is no barrier.
+  EXPECT_TRUE(parse_scenario(text("0.0", "").replace(text("0.0", "").find("[0.5, 0.0]"), 10, "[6.0, 0.0]"), "past.toml")
+                  .scene.has_value());
+}
+
+// Finding 4. `apex` is the highest y reached, the start included: a ball dropped from 10 m
+// and expected to bounce back to 10 m met it at t = 0 whatever the run did. ODE with a
+// bounce threshold (the ball stopped dead on the floor, half the energy gone) passed
+// `apex = [{ body = "ball", height = 10.0 }]`, exit 0. Such an apex is bad input now.
+TEST(Hunt, AnApexTheStartAlreadyMeetsIsRefused) {
+  auto text = [](const std::string& apex) {
+    return "name = \"drop\"\nduration = 4.0\n[world]\ngravity = [0.0, -9.81]\n[[bodies]]\nname = \"ball\"\n"
+           "radius = 0.5\nposition = [0.0, 10.0]\n[[walls]]\nname = \"floor\"\nfrom = [-5.0, -0.5]\n"
+           "to = [5.0, -0.5]\n[expect]\napex = [ " + apex + " ]\n";
+  };
+  for (const char* apex : {"{ body = \"ball\", height = 10.0 }", "{ body = \"ball\", height = 10.0005 }",
+                           "{ body = \"ball\", height = 9.9, tolerance = 0.2 }"}) {
+    const ScenarioLoad l = parse_scenario(text(apex), "drop.toml");
+    EXPECT_FALSE(l.scene.has_value()) << apex;
+    ASSERT_EQ(l.errors.size(), 1u) << apex;
+    EXPECT_EQ(l.errors[0].key, "expect.apex[0].height") << l.errors[0].str();
+    EXPECT_EQ(l.errors[0].str().rfind("drop.toml:", 0), 0u) << l.errors[0].str();
+  }
+  // Above the start (a ball thrown up), with its time, or out of the tolerance: it can fail.
+  for (const char* apex : {"{ body = \"ball\", height = 12.0 }", "{ body = \"ball\", height = 10.0, time = 2.9 }",
+                           "{ body = \"ball\", height = 9.0 }"}) {
+    EXPECT_TRUE(parse_scenario(text(apex), "drop.toml").scene.has_value()) << apex;
+  }
+}
+
+// Finding 3. A ball dropped 10 m onto a floor: the same motion whatever the floor's width,
+// but the energy scale was M |g| x the scene's diagonal, so a 2 km floor made every energy
+// drift 200x smaller. Box2D gains 2% of the ball's energy per bounce (apex 10.21 m): its
+// energy_drift read 1.7e-2 on a 2 m floor (a gate of 1e-2 failed it) and 1.6e-5 on a 20 km
+// one (the same gate passed it). Oracle: the drift of the run's own energies over
+// m g H, H = 10.5 m the scene's extent along g (floor to the ball's top), whatever the width.
+TEST(Hunt, EnergyDriftDoesNotShrinkWithAWiderFloor) {
+  int runs = 0;
+  for (double half_width : {1.0, 5.0, 100.0, 10000.0}) {
+    Scene s;
+    s.name = "wide_floor";
+    s.dt = 1.0 / 60.0;
+    s.duration = 4.5;
+    s.world.gravity = {0.0, -9.8};
+    s.bodies = {circle("ball", {0.0, 10.0}, 0.5, 2.0)};
+    WallDef floor;
+    floor.name = "floor";
+    floor.from = {-half_width, 0.0};
+    floor.to = {half_width, 0.0};
+    s.walls = {floor};
+    const double scale = 2.0 * 9.8 * 10.5;
+    for (const EngineFactory& f : engine_registry()) {
+      if (!unsupported_features(f.info, s).empty()) continue;
+      const RunRecord r = run_and_compare(s, f);
+      if (r.status == RunStatus::Error) continue;
+      ++runs;
+      double drift = 0.0;
+      for (const Totals& t : r.series.totals) drift = std::max(drift, std::abs(t.energy() - r.series.totals[0].energy()));
+      drift /= scale;
+      ASSERT_TRUE(r.metrics.at("energy_drift").has_value()) << f.info.name;
+      EXPECT_NEAR(*r.metrics.at("energy_drift"), drift, 1e-12 + 1e-9 * drift) << f.info.name << " floor half-width "
+                                                                             << half_width;
+    }
+  }
+  EXPECT_GT(runs, 8);
+}
+
+// Core bugs the hunt found (core/ belongs to other helpers; reported, not fixed here). Each
+// scene's [expect] is its closed form and core misses it today: enable when core is fixed.
+// v_trough_inelastic: an e = 0 ball meeting both faces of a V at once is resolved face after
+// face in wall order and leaves sideways (symmetry broken; every other engine stops it).
+// point_on_floor_exact: a point starting exactly on a floor, moving into it, falls through.
+TEST(Hunt, DISABLED_CoreMeetsTheClosedFormsOfTheHuntsCoreRepros) {
+  const EngineFactory* core = reference_engine();
+  ASSERT_NE(core, nullptr);
+  for (const char* file : {"v_trough_inelastic.toml", "point_on_floor_exact.toml"}) {
+    const ScenarioLoad l = load_scenario_file(std::string(PHYSVAL_SOURCE_DIR) + "/validation/tests/hunt/" + file);
+    ASSERT_TRUE(l.scene.has_value()) << file;
+    const RunRecord r = run_and_compare(*l.scene, *core);
+    EXPECT_EQ(r.status, RunStatus::Ok) << file << ": " << r.reason;
+    ASSERT_TRUE(r.metrics.at("expectation_failures").has_value()) << file;
+    EXPECT_EQ(*r.metrics.at("expectation_failures"), 0.0) << file;
+  }
+}
+
+}  // namespace
+}  // namespace physval
