@@ -12,6 +12,10 @@
 
 namespace physval {
 
+// GCC's 128-bit integer (a 53-bit mantissa times a power of ten up to 10^17 needs it);
+// __extension__ says so to -Wpedantic.
+__extension__ typedef unsigned __int128 uint128_for_text;
+
 inline char* to_chars_g12(char* out, char* end, double v) {
   auto slow = [&] { return std::to_chars(out, end, v, std::chars_format::general, 12).ptr; };
   const double a = std::fabs(v);
@@ -32,12 +36,12 @@ inline char* to_chars_g12(char* out, char* end, double v) {
     if (attempt == 3) return slow();
     const int k = 11 - exp10;                 // n = round(|v| * 10^k), 12 digits
     if (k < 0 || k > 17 || -e >= 127) return slow();
-    const unsigned __int128 scaled = static_cast<unsigned __int128>(m) * kPow10[k];   // < 2^53 * 2^57
+    const uint128_for_text scaled = static_cast<uint128_for_text>(m) * kPow10[k];   // < 2^53 * 2^57
     const int shift = -e;
     if (shift <= 0) return slow();
-    const unsigned __int128 q = scaled >> shift;
-    const unsigned __int128 rem = scaled - (q << shift);
-    const unsigned __int128 half = static_cast<unsigned __int128>(1) << (shift - 1);
+    const uint128_for_text q = scaled >> shift;
+    const uint128_for_text rem = scaled - (q << shift);
+    const uint128_for_text half = static_cast<uint128_for_text>(1) << (shift - 1);
     if (rem == half) return slow();           // an exact tie: leave the rounding rule to to_chars
     n = static_cast<std::uint64_t>(q) + (rem > half ? 1 : 0);
     if (n >= kPow10[12]) {
