@@ -140,11 +140,20 @@ int apply_baseline(SuiteResult& result, const nlohmann::json& baseline, double f
       for (const char* name : kErrorMetrics) {
         if (!om.contains(name) || !om[name].is_number()) continue;
         auto mine = r.metrics.find(name);
-        if (mine == r.metrics.end() || !mine->second) continue;
         const double before = om[name].get<double>();
         Check c;
         c.what = std::string("baseline.") + name;
         c.limit = factor * before + floor;
+        if (mine == r.metrics.end() || !mine->second) {
+          // The baseline measured it and this run could not (its reference stopped
+          // converging, say): the regression it would show is hidden, so the check fails.
+          c.value.reset();
+          c.pass = false;
+          c.detail = "not measured in this run; the baseline measured " + g(before);
+          c.enforced = true;
+          r.checks.push_back(c);
+          continue;
+        }
         c.value = *mine->second;
         c.pass = std::isfinite(*c.value) && *c.value <= c.limit;
         c.enforced = true;

@@ -361,5 +361,31 @@ TEST(Gate, BaselineFailsOnRegressionBeyondFactor) {
   }
 }
 
+// A metric the baseline measured and this run did not (null: a reference that stopped
+// converging, say) hid every regression in it: the check passed by being skipped.
+TEST(Gate, BaselineFailsWhenAMeasuredMetricIsNoLongerMeasured) {
+  SuiteResult result;
+  ScenarioResult sr;
+  sr.scene = two_bodies();
+  RunRecord r = run_engine(sr.scene, fake(Fault::None), RunOptions{});
+  r.metrics["energy_drift"] = 1e-6;
+  r.metrics["position_divergence"] = std::nullopt;
+  sr.runs = {r};
+  result.scenarios.push_back(sr);
+  const nlohmann::json baseline = {
+      {"runs", {{{"scenario", "two"}, {"engine", "fake"}, {"metrics", {{"energy_drift", 1e-6}, {"position_divergence", 1e-3}}}}}}};
+  EXPECT_EQ(apply_baseline(result, baseline, 2.0), 1);
+  const auto& checks = result.scenarios[0].runs[0].checks;
+  ASSERT_EQ(checks.size(), 2u);
+  for (const Check& c : checks) {
+    if (c.what == "baseline.energy_drift") EXPECT_TRUE(c.pass);
+    if (c.what == "baseline.position_divergence") {
+      EXPECT_FALSE(c.pass);
+      EXPECT_FALSE(c.value.has_value());
+      EXPECT_NE(c.detail.find("not measured"), std::string::npos) << c.detail;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace physval
