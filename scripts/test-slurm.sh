@@ -134,35 +134,8 @@ single_status=0
 "$physval" gate "${suite[@]}" -j "$cpus" --no-cache --quiet --out "$work/single" --junit "$work/single.xml" || single_status=$?
 
 fail=0
-if [ "$merged_status" != "$single_status" ]; then
-  echo "test-slurm: DIFFERENT exit status: merged $merged_status, single $single_status" >&2
-  fail=1
-fi
-python3 - "$work/single/results.json" "$work/merged/results.json" <<'PY' || fail=1
-import json, sys
-def strip(x):
-    if isinstance(x, dict):
-        return {k: strip(v) for k, v in x.items() if k not in ("wall_seconds", "load_seconds", "context")}
-    if isinstance(x, list):
-        return [strip(v) for v in x]
-    return x
-single, merged = (strip(json.load(open(p))) for p in sys.argv[1:3])
-if single != merged:
-    for key in single:
-        if single.get(key) != merged.get(key):
-            print(f"test-slurm: results.json differ in {key!r}", file=sys.stderr)
-    sys.exit(1)
-print(f"test-slurm: results.json equal apart from timings ({len(single['runs'])} runs)")
-PY
-if ! diff <(sed -E 's/ (time|timestamp)="[^"]*"//g' "$work/single.xml") \
-          <(sed -E 's/ (time|timestamp)="[^"]*"//g' "$work/merged.xml") >/dev/null; then
-  echo "test-slurm: DIFFERENT JUnit files" >&2
-  fail=1
-fi
-if ! diff -r "$work/single/series" "$work/merged/series" >/dev/null; then
-  echo "test-slurm: DIFFERENT series/" >&2
-  fail=1
-fi
+"$here/scripts/compare-runs.sh" test-slurm "$work/single" "$work/single.xml" "$single_status" \
+  "$work/merged" "$work/merged.xml" "$merged_status" || fail=1
 if ((fail)); then
   echo "test-slurm: FAILED (KEEP=1 keeps $work)" >&2
   exit 1
