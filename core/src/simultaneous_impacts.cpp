@@ -16,9 +16,15 @@
 // "At the same time" is geometric: a contact is in the set when its gap is within
 // kGapUlps ulps of the scene's coordinates (the round-off of the root of a gap
 // polynomial and of a few path advances), i.e. when its own impact, if any, is due
-// within round-off of t. Friction, supported bodies and collision-matrix rules are
-// left to the pairwise path: a set that meets any of them (or a scene with a collision
-// matrix) is resolved pair by pair.
+// within round-off of t. Faces, bodies at rest or sliding on a face (leaves: with their
+// faces only) and friction take part; a scene with a collision matrix, points and
+// particles are left to the pairwise path.
+//
+// With friction the set is solved by projected Jacobi, and every body's velocity change
+// is summed exactly from its impulses, so the answer is the same to the last bit for
+// every numbering of the bodies and exactly mirrored in a mirrored scene; a friction set
+// whose impulses would raise the kinetic energy is solved again under Moreau's law, then
+// inelastically (see friction_solve below).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -33,7 +39,6 @@ namespace {
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 constexpr double kGapUlps = 1024.0;
 constexpr std::size_t kMaxContacts = 256;
-constexpr std::size_t kSlidingSet = 1000000;   // sliding bodies join sets of at most this many bodies
 constexpr std::uint32_t kSegmentContact = kSimultaneousFace;
 
 double inf_norm(Vec2 v) { return std::max(std::fabs(v.x), std::fabs(v.y)); }
@@ -182,15 +187,9 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   thread_local std::vector<Contact> contacts;
   thread_local std::vector<std::uint32_t> found;
   thread_local std::vector<double> A, w0;
-  // A body sliding on a face takes part too (with its faces, as a leaf): a ball landing
-  // on two balls that slide apart meets both at once. In a large set (the bottom of a
-  // pile, where sliding bodies touch each other in rows) that spread zero-time impacts
-  // through the pile until the event cap, so a set of more than kSlidingSet bodies is
-  // gathered again without them (they meet it pair by pair, as before).
-  bool with_sliding = true;
-  const auto eligible = [&](std::uint32_t i) {
-    return eligible_body(w, i) && (with_sliding || !w.supported(i) || w.stationary(i));
-  };
+  // A body sliding on a face takes part too, as a leaf (with its faces): a ball landing
+  // on two balls that slide apart meets both at once.
+  const auto eligible = [&](std::uint32_t i) { return eligible_body(w, i); };
   const auto gather = [&]() -> bool {
     contacts.clear();
     bodies.clear();
@@ -314,12 +313,6 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     return true;
   };
   if (!gather()) return false;
-  const bool any_sliding = std::any_of(bodies.begin(), bodies.end(),
-                                       [&](std::uint32_t b) { return w.supported(b) && !w.stationary(b); });
-  if (any_sliding && bodies.size() > kSlidingSet) {
-    with_sliding = false;
-    if (!gather()) return false;
-  }
   if (contacts.size() < 2) return false;   // one contact: the pairwise law is the same
 
   for (std::uint32_t b : bodies) w.advance(b, t);
@@ -476,15 +469,24 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     for (std::size_t s = 0; s < bodies.size(); ++s) {
       const std::uint32_t b0 = term_start[s], b1 = term_start[s + 1];
       const double m = inv(bodies[s]);
+      if (!(m > 0.0)) {
+        dv[s] = {};
+        continue;
+      }
+      // Only the rows with an impulse (most are often 0): a body with two pays a plain sum.
       sum_x.resize(b1 - b0);
       sum_y.resize(b1 - b0);
+      std::size_t nz = 0;
       for (std::uint32_t f = b0; f < b1; ++f) {
+        const double pk = p[term_row[f]];
+        if (pk == 0.0) continue;
         const Row& rk = rows[term_row[f]];
-        const double imp = term_sign[f] * (p[term_row[f]] * m);
-        sum_x[f - b0] = imp * rk.d.x;
-        sum_y[f - b0] = imp * rk.d.y;
+        const double imp = term_sign[f] * (pk * m);
+        sum_x[nz] = imp * rk.d.x;
+        sum_y[nz] = imp * rk.d.y;
+        ++nz;
       }
-      dv[s] = {exact_sum(sum_x.data(), b1 - b0), exact_sum(sum_y.data(), b1 - b0)};
+      dv[s] = {exact_sum(sum_x.data(), nz), exact_sum(sum_y.data(), nz)};
     }
   };
   // With friction the solutions can form a family (a ball wedged on two that slide: how
