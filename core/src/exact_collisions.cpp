@@ -57,28 +57,13 @@ double inf_norm(Vec2 v) { return std::max(std::fabs(v.x), std::fabs(v.y)); }
 
 class EventLoop {
  public:
-  EventLoop(World& w, StepContext& ctx) : w_(w), ctx_(ctx), T_(ctx.dt) {}
+  EventLoop(World& w, StepContext& ctx) : w_(w), ctx_(ctx), T_(ctx.dt), coupled_(w.coupled()) {}
 
   void run() {
     prune_passing(w_);
     w_.events.start(T_);
-    const std::size_t n = w_.size();
-    std::span<Aabb> boxes = w_.bp->prepare(n);
-    w_.active.resize(n);
-    for (std::uint32_t i = 0; i < n; ++i) {
-      w_.active[i] = w_.alive(i) ? 1 : 0;
-      if (w_.active[i]) boxes[i] = path_box(w_, i, 0.0, T_);
-    }
-    w_.bp->build(w_.active);
-    w_.pairs.clear();
-    w_.bp->pairs(w_.pairs);
+    schedule_all(0.0);
     w_.stats.candidate_pairs = static_cast<std::int64_t>(w_.pairs.size());
-    for (const BodyPair& p : w_.pairs) schedule_pair(p.a, p.b, 0.0);
-    for (std::uint32_t i = 0; i < n; ++i) {
-      if (!w_.dynamic(i)) continue;
-      schedule_statics(i, 0.0, w_.bp->box(i));
-      schedule_body(i, 0.0);
-    }
     if (!w_.emitters.empty()) {
       w_.scratch_events.clear();
       schedule_explosions(w_, ctx_, w_.scratch_events);
@@ -98,12 +83,68 @@ class EventLoop {
         return;
       }
       ++ctx_.events;
-      process(e);
+      if (coupled_) {
+        process_coupled(e);
+      } else {
+        process(e);
+      }
     }
   }
 
  private:
   void push(const Event& e) { w_.events.push(e); }
+
+  // Every body's path registered with the broad phase from t, and its events found.
+  void schedule_all(double t) {
+    const std::size_t n = w_.size();
+    std::span<Aabb> boxes = w_.bp->prepare(n);
+    w_.active.resize(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      w_.active[i] = w_.alive(i) ? 1 : 0;
+      if (w_.active[i]) boxes[i] = path_box(w_, i, t, T_);
+    }
+    w_.bp->build(w_.active);
+    w_.pairs.clear();
+    w_.bp->pairs(w_.pairs);
+    for (const BodyPair& p : w_.pairs) schedule_pair(p.a, p.b, t);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      if (!w_.dynamic(i)) continue;
+      schedule_statics(i, t, w_.bp->box(i));
+      schedule_body(i, t);
+    }
+  }
+
+  // Newtonian gravity (w.coupled()): an event that changes a path cuts the step of the
+  // whole system (substeps.cpp). Its time is refined on the system's integrator step,
+  // every free body is put at its state there, the event is processed as usual, and
+  // the system's next sub-step starts there: new paths, every body's events found
+  // again (the old ones go stale with a new version).
+  void process_coupled(Event e) {
+    bool cuts = e.kind() != EventKind::Emit;
+    if (e.kind() == EventKind::Pair) {
+      if (w_.response(w_.group[e.a], w_.group[e.b]).collide) {
+        e.time = refine_coupled_pair(w_, e.a, e.b, e.time, std::max(w_.tloc[e.a], w_.tloc[e.b]), T_);
+      } else {
+        cuts = false;   // passes through: no path changes
+      }
+    } else if (e.kind() == EventKind::Static) {
+      const Segment& seg = w_.statics.segments[e.b];
+      if (w_.response(w_.group[e.a], seg.group).collide) {
+        e.time = refine_coupled_static(w_, e.a, seg, e.feature() != 0, e.time, w_.tloc[e.a], T_);
+      } else {
+        cuts = false;
+      }
+    }
+    if (!cuts) {
+      process(e);
+      return;
+    }
+    coupled_cut(w_, e.time);
+    process(e);
+    coupled_restart(w_, e.time, T_);
+    for (std::uint32_t i = 0; i < w_.size(); ++i) ++w_.version[i];
+    schedule_all(e.time);
+  }
 
   // Asks for the memory the next event will read while this one is processed.
   void prefetch(const Event& e) const {
@@ -164,6 +205,12 @@ class EventLoop {
     const Vec2 dv = vj - vi;
     const Vec2 da = w_.path_acc(j) - w_.path_acc(i);
     const double R = w_.radius[i] + w_.radius[j];
+    // Apart (or just touching), not approaching and not accelerating together: with
+    // d = pj - pi, |d + dv s + da s^2 / 2|^2 >= |d|^2 >= R^2 for every s >= 0, so no
+    // impact this step. (A touching pair sliding side by side, d.dv = d.da = 0, was
+    // otherwise read as an impact at once, again and again, by the gap's tolerance.)
+    const Vec2 d0 = pj - pi;
+    if (dot(d0, dv) >= 0.0 && dot(d0, da) >= 0.0 && length_squared(d0) >= R * R) return;
     const double scale = inf_norm(pi) + inf_norm(pj) + R;
     // Round-off in dv is that of the bodies' own velocities, not of their difference: two
     // touching bodies moving together (an inelastic pair) approach at ~1e-17 m/s, an
@@ -320,13 +367,31 @@ class EventLoop {
     w_.bp->query_box(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), i, near_);
     if (try_hold(w_, i, ctx_.dt, near_, true)) return true;
     const double t = w_.tloc[i];
-    if (!try_hold_group(w_, i, t, ctx_.dt, [this](Vec2 q, double h, std::vector<std::uint32_t>& out) {
-          out.clear();
-          w_.bp->query_box(make_aabb(q.x - h, q.y - h, q.x + h, q.y + h), kNone, out);
-        }, group_)) {
+    const NearFn near = [this](Vec2 q, double h, std::vector<std::uint32_t>& out) {
+      out.clear();
+      w_.bp->query_box(make_aabb(q.x - h, q.y - h, q.x + h, q.y + h), kNone, out);
+    };
+    if (!try_hold_group(w_, i, t, ctx_.dt, near, group_) && !try_hold_group_pocket(w_, i, t, ctx_.dt, near, group_)) {
       return false;
     }
     // The other members' paths changed too (now at rest): new versions, no events.
+    for (std::uint32_t m : group_) {
+      if (m == i) continue;
+      ++w_.version[m];
+      reschedule(m, t);
+    }
+    return true;
+  }
+  // i, slow and free, pressed onto a slow free body: the pocket of the group they form
+  // with the slow bodies near them (try_hold_group_pocket), others rescheduled.
+  bool hold_pocket(std::uint32_t i) {
+    if (w_.stationary(i) || w_.supported(i)) return false;
+    const double t = w_.tloc[i];
+    const NearFn near = [this](Vec2 q, double h, std::vector<std::uint32_t>& out) {
+      out.clear();
+      w_.bp->query_box(make_aabb(q.x - h, q.y - h, q.x + h, q.y + h), kNone, out);
+    };
+    if (!try_hold_group_pocket(w_, i, t, ctx_.dt, near, group_)) return false;
     for (std::uint32_t m : group_) {
       if (m == i) continue;
       ++w_.version[m];
@@ -434,6 +499,8 @@ class EventLoop {
             settled = true;
           } else if (hold_against(i, j) || hold_against(j, i)) {
             settled = true;   // at rest on several supports
+          } else if (hold_pocket(i) || hold_pocket(j)) {
+            settled = true;   // a group micro-bouncing on its supports: its pocket
           } else {
             min_sep = 0.5 * vr;
           }
@@ -463,7 +530,14 @@ class EventLoop {
       }
       return false;
     };
-    if (!settled && resolve_simultaneous(w_, i, j, t, set_, impacted_, min_sep)) {
+    // A body met again and again at one instant by contacts that each look separating
+    // once the other has been resolved (a body falling into a slot between two at rest):
+    // its set takes every touching contact, separating or not, so that all are solved
+    // at once.
+    w_.sim_with_separating = cycling;
+    const bool simultaneous = !settled && resolve_simultaneous(w_, i, j, t, set_, impacted_, min_sep);
+    w_.sim_with_separating = false;
+    if (simultaneous) {
       if (wedged()) ++w_.stats.wedged;
       finish_simultaneous(t, t_abs);
       return;
@@ -620,6 +694,7 @@ class EventLoop {
   World& w_;
   StepContext& ctx_;
   const double T_;
+  const bool coupled_;   // Newtonian gravity: events cut the whole system's step
   std::vector<std::uint32_t> set_;      // the touching set of a simultaneous impact
   std::vector<BodyPair> impacted_;      // its pairs that took an impulse
   std::vector<std::uint32_t> near_;     // bodies near one being held

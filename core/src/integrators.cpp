@@ -78,6 +78,7 @@ void begin_paths(World& w, const StepContext& ctx) {
   const double dt = ctx.dt;
   if (w.varying_forces) {
     // Each body's first sub-step is the whole step (substeps.cpp: impacts cut it).
+    w.tcut = 0.0;
     std::fill(w.tsub.begin(), w.tsub.end(), 0.0);
     std::copy(w.pos.begin(), w.pos.end(), w.psub.begin());
     std::copy(w.vel.begin(), w.vel.end(), w.vsub.begin());

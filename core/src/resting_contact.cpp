@@ -523,6 +523,190 @@ bool try_hold_group(World& w, std::uint32_t seed, double t, double dt, const Nea
   return true;
 }
 
+bool try_hold_group_pocket(World& w, std::uint32_t seed, double t, double dt, const NearFn& near_fn,
+                           std::vector<std::uint32_t>& members) {
+  members.clear();
+  if (!w.dynamic(seed) || w.acc.empty() || w.supported(seed)) return false;
+  const auto slow = [&](std::uint32_t j) {
+    const double a = length(w.acc[j]);
+    return a > 0.0 && length(w.vel_at(j, t)) <= w.rest_speed(a, dt);
+  };
+  if (!slow(seed)) return false;
+  const double reach = w.rest_speed(length(w.acc[seed]), dt) * dt;
+  constexpr std::size_t kMaxMembers = 64;
+  thread_local std::vector<std::uint32_t> buf, group;
+  thread_local std::vector<Vec2> p0, pos, delta;
+  const auto pair_ok = [&](std::uint32_t m, std::uint32_t j) {
+    if (j == m || !w.alive(j)) return false;
+    if ((w.flags[m] & kPoint) && (w.flags[j] & kPoint)) return false;
+    if (((w.flags[m] | w.flags[j]) & kParticle) && related_bodies(w, m, j)) return false;
+    if (w.any_rules && !w.response(w.group[m], w.group[j]).collide) return false;
+    return true;
+  };
+  // The slow free bodies within reach of the seed, and of those in turn. A moving body
+  // that near (or one sliding on a face) ends it: nothing is held.
+  members.assign(1, seed);
+  for (std::size_t q = 0; q < members.size(); ++q) {
+    const std::uint32_t m = members[q];
+    near_fn(w.pos_at(m, t), 2.0 * w.radius[m] + reach, buf);
+    for (std::uint32_t j : buf) {
+      if (!pair_ok(m, j) || w.stationary(j)) continue;
+      if (std::find(members.begin(), members.end(), j) != members.end()) continue;
+      if (length(w.pos_at(j, t) - w.pos_at(m, t)) - (w.radius[m] + w.radius[j]) > reach) continue;
+      if (!w.dynamic(j) || w.supported(j) || !slow(j)) return false;
+      members.push_back(j);
+      if (members.size() > kMaxMembers) return false;
+    }
+  }
+  // Near contacts: member pairs, and members with stationary bodies and faces.
+  struct Near {
+    std::int32_t a, b;   // member indices; a = -1: a fixed body (other) or face (seg)
+    std::uint32_t other;
+    bool face;
+  };
+  thread_local std::vector<Near> cs;
+  cs.clear();
+  const std::size_t M = members.size();
+  for (std::size_t q = 0; q < M; ++q) {
+    const std::uint32_t m = members[q];
+    const double r = w.radius[m];
+    const Vec2 p = w.pos_at(m, t);
+    if (!w.statics.segments.empty()) {
+      w.found_static.clear();
+      const double pad = r + reach;
+      w.statics.query(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), w.found_static);
+      for (std::uint32_t k : w.found_static) {
+        const Segment& s = w.statics.segments[k];
+        if (w.any_rules && !w.response(w.group[m], s.group).collide) continue;
+        if (s.normal_from.x != 0.0 || s.normal_from.y != 0.0) return false;   // a surface: its own response
+        const double u = dot(p - s.from, s.dir);
+        if (u < 0.0 || u > s.length) continue;   // ends: the overlap test below guards them
+        if (std::fabs(dot(p - s.from, s.normal)) - r > reach) continue;
+        cs.push_back({-1, static_cast<std::int32_t>(q), k, true});
+      }
+    }
+    near_fn(p, 2.0 * r + reach, buf);
+    for (std::uint32_t j : buf) {
+      if (!pair_ok(m, j)) continue;
+      if (length(w.pos_at(j, t) - p) - (r + w.radius[j]) > reach) continue;
+      if (w.stationary(j)) {
+        cs.push_back({-1, static_cast<std::int32_t>(q), j, false});
+        continue;
+      }
+      const auto l = std::find(members.begin(), members.end(), j) - members.begin();
+      if (static_cast<std::size_t>(l) > q) cs.push_back({static_cast<std::int32_t>(q), static_cast<std::int32_t>(l), j, false});
+    }
+  }
+  if (cs.empty()) return false;
+  // Close every near contact: Newton on the gaps, each step the smallest mass-weighted
+  // displacement (J W J^T lambda = -gap by Gauss-Seidel, delta = W J^T lambda).
+  p0.resize(M);
+  pos.resize(M);
+  delta.resize(M);
+  for (std::size_t q = 0; q < M; ++q) p0[q] = pos[q] = w.pos_at(members[q], t);
+  const double close_tol = 1e-13 * (2.0 * w.radius[seed] + w.length_scale);
+  thread_local std::vector<double> gap, lam, akk;
+  thread_local std::vector<Vec2> nrm;
+  const std::size_t C = cs.size();
+  gap.resize(C);
+  lam.resize(C);
+  akk.resize(C);
+  nrm.resize(C);
+  const auto inv = [&](std::int32_t x) { return x < 0 ? 0.0 : w.inv_mass[members[static_cast<std::size_t>(x)]]; };
+  const auto measure = [&]() -> double {
+    double worst = 0.0;
+    for (std::size_t k = 0; k < C; ++k) {
+      const Near& c = cs[k];
+      const std::uint32_t mb = members[static_cast<std::size_t>(c.b)];
+      const Vec2 pb = pos[static_cast<std::size_t>(c.b)];
+      if (c.face) {
+        const Segment& s = w.statics.segments[c.other];
+        const double D = dot(pb - s.from, s.normal);
+        nrm[k] = D >= 0.0 ? s.normal : -s.normal;
+        gap[k] = std::fabs(D) - w.radius[mb];
+      } else {
+        const Vec2 pa = c.a < 0 ? w.pos_at(c.other, t) : pos[static_cast<std::size_t>(c.a)];
+        const std::uint32_t ma = c.a < 0 ? c.other : members[static_cast<std::size_t>(c.a)];
+        const Vec2 d = pb - pa;
+        const double dl = length(d);
+        if (!(dl > 0.0)) return INFINITY;
+        nrm[k] = d / dl;
+        gap[k] = dl - (w.radius[ma] + w.radius[mb]);
+      }
+      worst = std::max(worst, std::fabs(gap[k]));
+    }
+    return worst;
+  };
+  bool closed = false;
+  for (int newton = 0; newton < 12; ++newton) {
+    const double worst = measure();
+    if (!(worst < INFINITY)) return false;
+    if (worst <= close_tol) {
+      closed = true;
+      break;
+    }
+    std::fill(lam.begin(), lam.end(), 0.0);
+    std::fill(delta.begin(), delta.end(), Vec2{});
+    for (std::size_t k = 0; k < C; ++k) akk[k] = inv(cs[k].a) + inv(cs[k].b);
+    bool converged = false;
+    for (int sweep = 0; sweep < 2000 && !converged; ++sweep) {
+      double resid = 0.0;
+      for (std::size_t k = 0; k < C; ++k) {
+        if (!(akk[k] > 0.0)) continue;
+        const Near& c = cs[k];
+        const Vec2 da = c.a < 0 ? Vec2{} : delta[static_cast<std::size_t>(c.a)];
+        const Vec2 db = delta[static_cast<std::size_t>(c.b)];
+        const double rk = gap[k] + dot(db - da, nrm[k]);
+        resid = std::max(resid, std::fabs(rk));
+        const double dl = -rk / akk[k];
+        lam[k] += dl;
+        if (c.a >= 0) delta[static_cast<std::size_t>(c.a)] -= (dl * inv(c.a)) * nrm[k];
+        delta[static_cast<std::size_t>(c.b)] += (dl * inv(c.b)) * nrm[k];
+      }
+      converged = resid <= 0.01 * close_tol;
+    }
+    if (!converged) return false;   // the near contacts cannot all close at once
+    for (std::size_t q = 0; q < M; ++q) {
+      pos[q] += delta[q];
+      if (length(pos[q] - p0[q]) > reach) return false;
+    }
+  }
+  if (!closed) return false;
+  // No energy gained: the forces' work along the move at least minus the kinetic energy.
+  double work = 0.0, kinetic = 0.0;
+  for (std::size_t q = 0; q < M; ++q) {
+    const std::uint32_t m = members[q];
+    const double mass = 1.0 / w.inv_mass[m];
+    work += mass * dot(w.acc[m], pos[q] - p0[q]);
+    kinetic += 0.5 * mass * length_squared(w.vel_at(m, t));
+  }
+  if (work + kinetic < 0.0) return false;
+  // The members advance to t along their paths (nothing else changes), then move.
+  for (std::size_t q = 0; q < M; ++q) {
+    w.advance(members[q], t);
+    w.pos[members[q]] = pos[q];
+  }
+  const auto restore = [&]() {
+    for (std::size_t q = 0; q < M; ++q) w.pos[members[q]] = p0[q];
+    return false;
+  };
+  for (std::size_t q = 0; q < M; ++q) {
+    const std::uint32_t m = members[q];
+    near_fn(w.pos[m], 2.0 * w.radius[m], buf);
+    if (!clear_of_everything(w, m, buf)) return restore();
+  }
+  group.clear();
+  if (!try_hold_group(w, seed, t, dt, near_fn, group)) return restore();
+  // Held: any member left out of the held group goes back (it was only near).
+  for (std::size_t q = 0; q < M; ++q) {
+    if (std::find(group.begin(), group.end(), members[q]) == group.end()) {
+      w.pos[members[q]] = p0[q];
+    }
+  }
+  members = group;
+  return true;
+}
+
 bool hold_wedged(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near) {
   if (!w.dynamic(i) || w.is_held(i) || w.acc.empty()) return false;
   const double amag = length(w.acc[i]);
@@ -629,11 +813,11 @@ void detect_support(World& w, std::uint32_t i, const StepContext& ctx) {
 // The stationary bodies near a point: a uniform grid over them, rebuilt per pass.
 class NearGrid {
  public:
-  void build(const World& w, double cell) {
+  void build(const World& w, double cell, bool stationary_only = true) {
     cell_ = cell;
     keyed_.clear();
     for (std::uint32_t j = 0; j < w.size(); ++j) {
-      if (w.alive(j) && w.stationary(j)) keyed_.push_back({key(w.pos[j]), j});
+      if (w.alive(j) && (w.stationary(j) || !stationary_only)) keyed_.push_back({key(w.pos[j]), j});
     }
     std::sort(keyed_.begin(), keyed_.end());
   }
@@ -678,8 +862,9 @@ bool hold_pass(World& w, const StepContext& ctx) {
     if (w.is_held(i) || (w.dynamic(i) && (!w.supported(i) || !w.stuck(i)))) any = true;
   }
   if (!any) return false;
-  thread_local NearGrid grid;
-  thread_local std::vector<std::uint32_t> near;
+  thread_local NearGrid grid, all;
+  thread_local std::vector<std::uint32_t> near, group;
+  bool all_built = false;
   grid.build(w, std::max(2.0 * rmax, 1e-6 * w.length_scale) * (1.0 + 1e-6));
   bool changed = false;
   for (std::uint32_t i = 0; i < n; ++i) {
@@ -708,14 +893,35 @@ bool hold_pass(World& w, const StepContext& ctx) {
                         (w.apath[i].x != 0.0 || w.apath[i].y != 0.0);
     if (w.supported(i) && !driven) continue;
     grid.query(w.pos[i], near);
-    if (!try_hold(w, i, ctx.dt, near)) continue;
+    group.clear();
+    if (try_hold(w, i, ctx.dt, near)) {
+      group.push_back(i);
+    } else if (!w.supported(i)) {
+      // A group of slow bodies micro-bouncing on one another (each hop too short for any
+      // of them to be caught touching all its supports at once): its pocket, if it holds.
+      if (!all_built) {
+        double amax = 0.0;
+        for (std::uint32_t j = 0; j < n; ++j) {
+          if (w.alive(j)) amax = std::max(amax, length(w.acc[j]));
+        }
+        all.build(w, (2.0 * rmax + w.rest_speed(amax, ctx.dt) * ctx.dt + 1e-6 * w.length_scale) * (1.0 + 1e-6), false);
+        all_built = true;
+      }
+      const NearFn near_all = [&](Vec2 q, double, std::vector<std::uint32_t>& out) { all.query(q, out); };
+      if (!try_hold_group_pocket(w, i, 0.0, ctx.dt, near_all, group)) continue;
+      all_built = false;   // members moved
+    } else {
+      continue;
+    }
     changed = true;
-    for (const HeldContact& c : w.held) {
-      if (c.body != i) continue;
-      if (c.other & kBodySupport) {
-        record_contact(w, i, kNone, &w.statics.segments[c.other & ~kBodySupport], ctx.t0, ctx.dt);
-      } else {
-        record_contact(w, i, c.other, nullptr, ctx.t0, ctx.dt);
+    for (std::uint32_t b : group) {
+      for (const HeldContact& c : w.held) {
+        if (c.body != b) continue;
+        if (c.other & kBodySupport) {
+          record_contact(w, b, kNone, &w.statics.segments[c.other & ~kBodySupport], ctx.t0, ctx.dt);
+        } else {
+          record_contact(w, b, c.other, nullptr, ctx.t0, ctx.dt);
+        }
       }
     }
   }

@@ -129,7 +129,7 @@ bool touching(const World& w, std::uint32_t i, std::uint32_t j, double t, Contac
   const Vec2 vi = vel_now(w, i, t), vj = vel_now(w, j, t);
   const double wn = dot(vj - vi, n);
   const double vscale = length(vi) + length(vj);
-  if (wn > kGapUlps * kEps * vscale) return false;   // separating: no contact
+  if (wn > kGapUlps * kEps * vscale && !w.sim_with_separating) return false;   // separating: no contact
   c.a = i;
   c.b = j;
   c.n = n;
@@ -150,7 +150,7 @@ bool touching_face(const World& w, std::uint32_t i, std::uint32_t k, double t, C
   const Vec2 n = D >= 0.0 ? s.normal : -s.normal;
   const Vec2 v = vel_now(w, i, t);
   const double vscale = length(v);
-  if (dot(v, n) > kGapUlps * kEps * vscale) return false;
+  if (dot(v, n) > kGapUlps * kEps * vscale && !w.sim_with_separating) return false;
   c.a = kSegmentContact | k;
   c.b = i;
   c.n = n;
@@ -179,8 +179,18 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   // A slow seed impact (below the collapse speed) meets bodies at rest as fixed ones.
   bool fixed_rest = false;
   if (!w.acc.empty()) {
+    // Slow is the normal closing speed, as on the pairwise path: a body sliding fast past
+    // a held one with a tiny normal approach is a slow impact (taking it as fast pushed
+    // the held body along its face, the hold stopped it again at the same instant and the
+    // same impact recurred: a frictionless pile reached the event cap so).
     const Vec2 vj = face_seed ? Vec2{} : vel_now(w, j0, t);
-    fixed_rest = length(vj - vel_now(w, i0, t)) < w.collapse_speed(i0, face_seed ? i0 : j0);
+    double closing = length(vj - vel_now(w, i0, t));
+    if (!face_seed) {
+      const Vec2 d = pos_now(w, j0, t) - pos_now(w, i0, t);
+      const double dl = length(d);
+      if (dl > 0.0) closing = std::max(0.0, -dot(vj - vel_now(w, i0, t), d / dl));
+    }
+    fixed_rest = closing < w.collapse_speed(i0, face_seed ? i0 : j0);
   }
   if (fixed(w, i0, fixed_rest) && (face_seed || fixed(w, j0, fixed_rest))) return false;
   // Scratch kept between calls: an isolated impact (the common case) allocates nothing.
@@ -188,8 +198,14 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   thread_local std::vector<std::uint32_t> found;
   thread_local std::vector<double> A, w0;
   // A body sliding on a face takes part too, as a leaf (with its faces): a ball landing
-  // on two balls that slide apart meets both at once.
-  const auto eligible = [&](std::uint32_t i) { return eligible_body(w, i); };
+  // on two balls that slide apart meets both at once. Not on a frictionless face (a
+  // frictionless 10-circle pile, seed 3, then never settled: not yet understood).
+  const auto eligible = [&](std::uint32_t i) {
+    if (!eligible_body(w, i)) return false;
+    if (!w.supported(i) || w.stationary(i) || w.on_body(i) || w.is_held(i)) return true;
+    const PairMaterial m = w.pair_material(w.material[i], w.statics.segments[w.support[i]].material);
+    return m.friction > 0.0 || m.static_friction > 0.0;
+  };
   const auto gather = [&]() -> bool {
     contacts.clear();
     bodies.clear();
@@ -502,6 +518,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   if (friction) {
     rows_on.assign(bodies.size(), 0);
     for (std::size_t k = 0; k < R; ++k) {
+      if (rows[k].tangent) continue;   // a contact's own two rows are orthogonal: count it once
       if (slot_a[k] >= 0) ++rows_on[static_cast<std::size_t>(slot_a[k])];
       if (slot_b[k] >= 0) ++rows_on[static_cast<std::size_t>(slot_b[k])];
     }
@@ -510,7 +527,8 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       std::int32_t n = 1;
       if (slot_a[k] >= 0) n = std::max(n, rows_on[static_cast<std::size_t>(slot_a[k])]);
       if (slot_b[k] >= 0) n = std::max(n, rows_on[static_cast<std::size_t>(slot_b[k])]);
-      omega[k] = 1.0 / static_cast<double>(n);
+      // Gershgorin: 2 D / omega - A stays positive definite, so the damped sweep converges.
+      omega[k] = std::min(1.0, 1.9 / (1.0 + std::sqrt(2.0) * static_cast<double>(n - 1)));
     }
     pnew.assign(R, 0.0);
   }

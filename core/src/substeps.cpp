@@ -29,8 +29,22 @@
 // body with such forces, 4 acceleration evaluations for the new sub-step, and for
 // RK4 2 per gap evaluation of the refinement (typically 4 of them).
 // Explicit and semi-implicit Euler are first order with or without an impact inside
-// a step and keep their lecture paths. Newtonian gravity couples every body's path, so
-// its scenes keep one sub-step per step (an impact there costs RK4 its order).
+// a step and keep their lecture paths.
+//
+// Newtonian gravity couples every body's path: each body's stages depend on every
+// other body's stage positions, so no body can be cut alone (integrating one to its
+// impact with the others frozen, or on their parabolas, is first order). There the
+// whole system is cut (coupled sub-steps, below, driven by the exact loop): every free
+// body's sub-step starts at one time tcut; an event that changes a path (an impact, a
+// settle, a release, a particle's death) is found on the paths, its time moved to the
+// root of the gap on Phi of the whole system (RK4: one RK4 step of all bodies from tcut
+// to t, 2 N-body acceleration evaluations per gap evaluation; Verlet: its parabolas),
+// every free body is put at Phi(t), the event is processed, and the system starts a new
+// sub-step at t to the step's end (its stages over T - t, new paths, every body's events
+// found again). Each piece is one step of the scheme for the whole system, so the order
+// holds. Cost, per such event: the gap evaluations of the search (RK4), 3 (RK4) or 1 (Verlet)
+// N-body evaluations for the cut, 4 (RK4) or 1 (Verlet) for the new sub-step, and a
+// broad-phase rebuild; scenes without Newtonian gravity pay one branch per event.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -248,6 +262,178 @@ double refine_leave(const World& w, std::uint32_t i, double t, double t_min, dou
         return at_from ? u : seg.length - u;
       },
       t, t_min, T, ftol);
+}
+
+// ---- Coupled sub-steps: Newtonian gravity (every body's acceleration depends on every
+// body's position). One body cannot be cut alone: the step of the whole system is cut.
+
+namespace {
+
+bool free_body(const World& w, std::uint32_t i) { return w.dynamic(i) && !w.supported(i); }
+
+// The accelerations of every body at the stage state (w.cpl_x, w.cpl_v) into out.
+void coupled_stage(World& w, std::vector<Vec2>& out) {
+  out.resize(w.size());
+  compute_accelerations(w, w.cpl_x, w.cpl_v, out);
+}
+
+// Stage state at time ts + c h: free bodies from their sub-step start with the stage
+// velocity `vstage` (position x + c h vstage, velocity v + c h kprev); the others on
+// their own (constrained) paths.
+void set_stage(World& w, double ts, double ch, const std::vector<Vec2>* vprev, const std::vector<Vec2>& kprev) {
+  const std::size_t n = w.size();
+  w.cpl_x.resize(n);
+  w.cpl_v.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (!free_body(w, i)) {
+      w.cpl_x[i] = w.pos_at(i, ts + ch);
+      w.cpl_v[i] = w.vel_at(i, ts + ch);
+      continue;
+    }
+    const Vec2 v = vprev ? (*vprev)[i] : w.vsub[i];
+    w.cpl_x[i] = w.psub[i] + ch * v;
+    w.cpl_v[i] = w.vsub[i] + ch * kprev[i];
+  }
+}
+
+// The stages k2, k3 (and k4 if wanted) of RK4 for the whole system over step h from
+// its sub-step start, into w.cpl_k[0..2].
+void coupled_rk4_stages(World& w, double h, bool want_k4) {
+  const double ts = w.tcut;
+  std::vector<Vec2>& k2 = w.cpl_k[0];
+  std::vector<Vec2>& k3 = w.cpl_k[1];
+  std::vector<Vec2>& k4 = w.cpl_k[2];
+  set_stage(w, ts, 0.5 * h, nullptr, w.ksub);
+  coupled_stage(w, k2);
+  // v2 = v + h/2 k1 is what set_stage put in cpl_v; the next stage's position uses it.
+  w.cpl_vs.assign(w.cpl_v.begin(), w.cpl_v.end());
+  set_stage(w, ts, 0.5 * h, &w.cpl_vs, k2);
+  coupled_stage(w, k3);
+  if (!want_k4) return;
+  w.cpl_vs.assign(w.cpl_v.begin(), w.cpl_v.end());   // v3
+  set_stage(w, ts, h, &w.cpl_vs, k3);
+  coupled_stage(w, k4);
+}
+
+// The system's integrator position of free body i at time t (stages already computed
+// for h = t - tcut under RK4).
+Vec2 coupled_position(const World& w, std::uint32_t i, double h) {
+  if (w.integrator == Integrator::Rk4) {
+    return w.psub[i] + h * w.vsub[i] + (h * h / 6.0) * (w.ksub[i] + w.cpl_k[0][i] + w.cpl_k[1][i]);
+  }
+  return w.psub[i] + h * w.vsub[i] + (0.5 * h * h) * w.ksub[i];
+}
+
+// Positions of bodies i and j (j may be kNone) at time t on the system's integrator step.
+void coupled_positions(World& w, std::uint32_t i, std::uint32_t j, double t, Vec2& pi, Vec2& pj) {
+  const double h = t - w.tcut;
+  if (w.integrator == Integrator::Rk4) coupled_rk4_stages(w, h, false);
+  pi = free_body(w, i) ? coupled_position(w, i, h) : w.pos_at(i, t);
+  if (j != kNone) pj = free_body(w, j) ? coupled_position(w, j, h) : w.pos_at(j, t);
+}
+
+}  // namespace
+
+double refine_coupled_pair(World& w, std::uint32_t i, std::uint32_t j, double t, double t_min, double T) {
+  // Verlet's positions are its parabolas, the paths the impact was found on.
+  if (w.integrator != Integrator::Rk4 || (!free_body(w, i) && !free_body(w, j))) return t;
+  const double R = w.radius[i] + w.radius[j];
+  const double ftol = kTolUlps * kEps * (inf_norm(w.pos_at(i, t)) + inf_norm(w.pos_at(j, t)) + R);
+  return root_near(
+      [&](double s) {
+        Vec2 pi, pj;
+        coupled_positions(w, i, j, s, pi, pj);
+        return length(pj - pi) - R;
+      },
+      t, std::max(t_min, w.tcut), T, ftol);
+}
+
+double refine_coupled_static(World& w, std::uint32_t i, const Segment& seg, bool cap, double t, double t_min,
+                             double T) {
+  if (w.integrator != Integrator::Rk4 || !free_body(w, i)) return t;
+  const double r = w.radius[i];
+  const Vec2 pt = w.pos_at(i, t);
+  const double ftol = kTolUlps * kEps * (inf_norm(pt) + r);
+  const auto at = [&](double s) {
+    Vec2 p, unused;
+    coupled_positions(w, i, kNone, s, p, unused);
+    return p;
+  };
+  t_min = std::max(t_min, w.tcut);
+  if (cap) {
+    const Vec2 q = length_squared(pt - seg.from) <= length_squared(pt - seg.to) ? seg.from : seg.to;
+    return root_near([&](double s) { return length(at(s) - q) - r; }, t, t_min, T, ftol);
+  }
+  const double D = dot(w.pos[i] - seg.from, seg.normal);
+  const double side = D > 0.0 ? 1.0 : D < 0.0 ? -1.0 : (dot(w.vel[i], seg.normal) < 0.0 ? 1.0 : -1.0);
+  return root_near([&](double s) { return side * dot(at(s) - seg.from, seg.normal) - r; }, t, t_min, T, ftol);
+}
+
+void coupled_cut(World& w, double t) {
+  const std::size_t n = w.size();
+  const double h = t - w.tcut;
+  if (h == 0.0) return;   // every free body is there already (restarted at t)
+  if (w.integrator == Integrator::Rk4) {
+    coupled_rk4_stages(w, h, true);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      if (!free_body(w, i)) continue;
+      w.pos[i] = coupled_position(w, i, h);
+      w.vel[i] = w.vsub[i] + (h / 6.0) * (w.ksub[i] + 2.0 * w.cpl_k[0][i] + 2.0 * w.cpl_k[1][i] + w.cpl_k[2][i]);
+      w.tloc[i] = t;
+    }
+    return;
+  }
+  // Velocity Verlet: the parabola, then 1/2 h (a(x(t), v_pred) - a(t_s)).
+  w.cpl_x.resize(n);
+  w.cpl_v.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (free_body(w, i)) {
+      w.cpl_x[i] = coupled_position(w, i, h);
+      w.cpl_v[i] = w.vsub[i] + h * w.ksub[i];
+    } else {
+      w.cpl_x[i] = w.pos_at(i, t);
+      w.cpl_v[i] = w.vel_at(i, t);
+    }
+  }
+  coupled_stage(w, w.cpl_k[0]);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (!free_body(w, i)) continue;
+    w.pos[i] = w.cpl_x[i];
+    w.vel[i] = w.cpl_v[i] + (0.5 * h) * (w.cpl_k[0][i] - w.ksub[i]);
+    w.tloc[i] = t;
+  }
+}
+
+void coupled_restart(World& w, double t, double T) {
+  const std::size_t n = w.size();
+  w.cpl_x.resize(n);
+  w.cpl_v.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    w.cpl_x[i] = w.pos_at(i, t);
+    w.cpl_v[i] = w.vel_at(i, t);
+  }
+  std::vector<Vec2>& k1 = w.cpl_k[2];
+  coupled_stage(w, k1);
+  w.tcut = t;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (!free_body(w, i)) continue;
+    w.advance(i, t);
+    w.acc[i] = k1[i];
+    w.tsub[i] = t;
+    w.psub[i] = w.pos[i];
+    w.vsub[i] = w.vel[i];
+    w.ksub[i] = k1[i];
+    w.apath[i] = k1[i];
+    w.vcorr[i] = {};
+  }
+  if (w.integrator != Integrator::Rk4) return;   // Verlet: end_paths corrects from tsub
+  const double h = T - t;
+  coupled_rk4_stages(w, h, true);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (!free_body(w, i)) continue;
+    w.apath[i] = (1.0 / 3.0) * (w.ksub[i] + w.cpl_k[0][i] + w.cpl_k[1][i]);
+    w.vcorr[i] = (h / 6.0) * (w.cpl_k[2][i] - w.ksub[i]);
+  }
 }
 
 }  // namespace physval::core_detail

@@ -129,6 +129,10 @@ struct World {
   Integrator integrator = Integrator::VelocityVerlet;
   CollisionMode mode = CollisionMode::Exact;
   ImpactLaw impact_law = ImpactLaw::Simultaneous;
+  // Set by the event loop while a body cycles through impacts at one instant: the
+  // simultaneous set then takes its touching contacts that separate too (the LCP gives
+  // them no impulse unless the others' impulses would close them).
+  bool sim_with_separating = false;
   BroadPhaseKind broadphase = BroadPhaseKind::Grid;
   bool broadphase_auto = true;
   double cell_size = 0.0;
@@ -166,6 +170,10 @@ struct World {
   // starts a new sub-step there (substeps.cpp). Its start time, state and acceleration:
   std::vector<double> tsub;
   std::vector<Vec2> psub, vsub, ksub;
+  // coupled(): the whole system's current sub-step started at tcut (every free body's
+  // tsub, psub, vsub, ksub are its state there); scratch for its stages.
+  double tcut = 0.0;
+  std::vector<Vec2> cpl_x, cpl_v, cpl_vs, cpl_k[3];
   std::vector<ForceParams> fparams;  // drag or thrust only
   std::vector<ThrustDef> thrusts;
   std::vector<std::uint32_t> support;   // any_forces: segment (or kBodySupport | body) a body rests on, or kNone
@@ -290,6 +298,12 @@ struct World {
     if (acc.empty() || step_dt == 0.0) return 0.0;
     return rest_speed(std::max(length(acc[i]), length(acc[j])), step_dt);
   }
+  // Newtonian gravity couples every body's path: under velocity Verlet or RK4 with
+  // exact impacts, a path-changing event cuts the whole system's step (substeps.cpp).
+  bool coupled() const {
+    return newtonian && mode == CollisionMode::Exact &&
+           (integrator == Integrator::VelocityVerlet || integrator == Integrator::Rk4);
+  }
   std::size_t memory_bytes() const;
 };
 
@@ -352,6 +366,17 @@ bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_
 using NearFn = std::function<void(Vec2, double, std::vector<std::uint32_t>&)>;
 bool try_hold_group(World& w, std::uint32_t seed, double t, double dt, const NearFn& near_fn,
                     std::vector<std::uint32_t>& members);
+// A group's pocket (the limit of its inelastic collapse): the slow free bodies within
+// rest_speed x dt of the seed (and of each other), with their faces and stationary
+// bodies that near, moved (each at most rest_speed x dt, by the smallest mass-weighted
+// displacement) to where all those near contacts touch, then held there by
+// try_hold_group. Only when that gains no energy (the work of their forces along the
+// move is at least minus their kinetic energy), overlaps nothing and holds them all;
+// otherwise nothing changes (but the members' advance to t along their paths).
+// near_fn(p, pad, out): every body (stationary or not) whose box meets the square of
+// half-side pad around p.
+bool try_hold_group_pocket(World& w, std::uint32_t seed, double t, double dt, const NearFn& near_fn,
+                           std::vector<std::uint32_t>& members);
 // A slow body wedged among stationary bodies and faces (no impulse moves it, so the
 // same impact would recur at the same instant for ever) is held where it is, whether
 // or not its contacts balance its force exactly; the next step judges it again.
@@ -378,7 +403,8 @@ double support_leave_time(const World& w, std::uint32_t i, double t, double T);
 // Sub-steps (substeps.cpp): an impact inside a step keeps the integrator's order.
 // Whether body i follows sub-steps of its integrator, so that a velocity change inside
 // a step starts a new one: state-dependent forces, velocity Verlet or RK4, no Newtonian
-// gravity, free or sliding on a face (not at rest on bodies).
+// gravity (there the whole system is cut: coupled sub-steps, below), free or sliding on
+// a face (not at rest on bodies).
 bool uses_substeps(const World& w, std::uint32_t i);
 // The acceleration of body i on sub-steps at velocity v: its forces', or on a face the
 // support's law with friction against the sliding direction of the sub-step's start.
@@ -405,6 +431,16 @@ double refine_pair_impact(const World& w, std::uint32_t i, std::uint32_t j, doub
 // its leaving the end of its segment.
 double refine_stop(const World& w, std::uint32_t i, double t, double t_min, double T);
 double refine_leave(const World& w, std::uint32_t i, double t, double t_min, double T);
+// Coupled sub-steps (w.coupled(), substeps.cpp): every free body follows one step of
+// the integrator of the whole system from w.tcut. An impact at t found on the paths is
+// moved to the root of its gap on that step (RK4; Verlet's positions are its paths);
+// coupled_cut puts every free body at the system's integrator state at t; after the
+// event, coupled_restart starts the system's next sub-step there, to T.
+double refine_coupled_pair(World& w, std::uint32_t i, std::uint32_t j, double t, double t_min, double T);
+double refine_coupled_static(World& w, std::uint32_t i, const Segment& seg, bool cap, double t, double t_min,
+                             double T);
+void coupled_cut(World& w, double t);
+void coupled_restart(World& w, double t, double T);
 
 // Box bounding body i's path from t to T (swept), plus its radius.
 Aabb path_box(const World& w, std::uint32_t i, double t, double T);

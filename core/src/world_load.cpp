@@ -334,6 +334,8 @@ std::size_t World::memory_bytes() const {
   n += bytes_of(active) + bytes_of(pairs) + bytes_of(found) + bytes_of(found_static);
   n += events.memory_bytes() + bytes_of(passing) + bytes_of(scratch_p) + bytes_of(scratch_v) + bytes_of(scratch_f);
   for (const auto& s : scratch_a) n += bytes_of(s);
+  n += bytes_of(cpl_x) + bytes_of(cpl_v) + bytes_of(cpl_vs);
+  for (const auto& s : cpl_k) n += bytes_of(s);
   n += bytes_of(contacts);
   return n;
 }
