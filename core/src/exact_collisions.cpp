@@ -644,7 +644,7 @@ class EventLoop {
     if (slow && face && !own_support && !w_.stationary(i) && hold(i)) {
       // Pressed into a second face (a corner, a V) or a face beside bodies at rest:
       // held at rest there if its contacts together can hold it.
-    } else if (slow && face && !w_.supported(i) && !w_.any_rules && touches_another_face(w_, i, k, t) &&
+    } else if (slow && face && !w_.supported(i) && !w_.any_rules && touches_another_face(i, k) &&
                resolve_simultaneous(w_, i, kSimultaneousFace | k, t, set_, impacted_)) {
       // A free body meeting two faces at one instant (a V, a corner) too slowly to bounce
       // clear: Newton's law at both at once (settling on the first face found and then
@@ -686,6 +686,30 @@ class EventLoop {
     destroy_after(i, r.destroy_first);
     reschedule(i, t);
     free_dependents(i, t);
+  }
+
+  // Whether body i (advanced to now) touches a face other than k, at rest or closing (the
+  // same round-off window as the simultaneous set's contacts).
+  bool touches_another_face(std::uint32_t i, std::uint32_t k) {
+    const Vec2 p = w_.pos[i];
+    const double r = w_.radius[i];
+    const double pad = r * (1.0 + 1e-9) + 1024.0 * 2.220446049250313e-16 * (std::max(std::fabs(p.x), std::fabs(p.y)) + w_.length_scale);
+    w_.found_static.clear();
+    w_.statics.query(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), w_.found_static);
+    for (std::uint32_t o : w_.found_static) {
+      if (o == k) continue;
+      const Segment& s = w_.statics.segments[o];
+      if (!w_.response(w_.group[i], s.group).collide) continue;
+      const double u = dot(p - s.from, s.dir);
+      if (u < 0.0 || u > s.length) continue;
+      const double D = dot(p - s.from, s.normal);
+      const double scale = std::max(std::fabs(p.x), std::fabs(p.y)) + r + std::max(std::fabs(s.from.x), std::fabs(s.from.y)) +
+                           std::max(std::fabs(s.to.x), std::fabs(s.to.y));
+      if (std::fabs(D) - r > 1024.0 * 2.220446049250313e-16 * scale) continue;
+      const Vec2 n = D >= 0.0 ? s.normal : -s.normal;
+      if (dot(w_.vel[i], n) <= 1024.0 * 2.220446049250313e-16 * length(w_.vel[i])) return true;
+    }
+    return false;
   }
 
   void finish_with_lecture_pass(double t) {

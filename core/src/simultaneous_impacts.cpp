@@ -654,20 +654,4 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   return true;
 }
 
-// Whether body i (at t) touches a face other than k that it collides with, at rest or
-// closing: a second face of the same instant (a V, a corner), by the set's own contact test.
-bool touches_another_face(World& w, std::uint32_t i, std::uint32_t k, double t) {
-  if (w.statics.segments.size() < 2) return false;
-  const Vec2 p = pos_now(w, i, t);
-  const double pad = w.radius[i] * (1.0 + 1e-9) + kGapUlps * kEps * (inf_norm(p) + w.length_scale);
-  w.found_static.clear();
-  w.statics.query(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), w.found_static);
-  for (std::uint32_t o : w.found_static) {
-    if (o == k || !w.response(w.group[i], w.statics.segments[o].group).collide) continue;
-    Contact c;
-    if (touching_face(w, i, o, t, c) && dot(vel_now(w, i, t), c.n) <= kGapUlps * kEps * c.vscale) return true;
-  }
-  return false;
-}
-
 }  // namespace physval::core_detail

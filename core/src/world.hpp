@@ -464,8 +464,6 @@ inline constexpr std::uint32_t kSimultaneousFace = 0x80000000u;
 // seed_min_sep: the pair (i, j) leaves at least this fast (a micro-bounce).
 bool resolve_simultaneous(World& w, std::uint32_t i, std::uint32_t j, double t, std::vector<std::uint32_t>& bodies,
                           std::vector<BodyPair>& impacted, double seed_min_sep = 0.0);
-// Whether body i touches, at t, a face other than segment k's (at rest or closing).
-bool touches_another_face(World& w, std::uint32_t i, std::uint32_t k, double t);
 ImpactResult resolve_static(World& w, std::uint32_t i, Vec2 n, const PairMaterial& m,
                             double min_separation_speed);
 // Records a contact event if the contact begins (see exact_collisions.cpp) at absolute

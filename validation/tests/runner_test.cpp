@@ -337,25 +337,18 @@ TEST(Gate, JunitHasACasePerScenarioAndEngine) {
   EXPECT_NE(xml.find("energy_drift = 1 &gt; limit 1e-09"), std::string::npos) << xml;
 }
 
-// One fake run of "two" with these two metrics, and a baseline that measured
-// energy_drift 1e-6 and position_divergence 1e-3.
-SuiteResult suite_with(std::optional<double> energy_drift, std::optional<double> position_divergence) {
+TEST(Gate, BaselineFailsOnRegressionBeyondFactor) {
   SuiteResult result;
   ScenarioResult sr;
   sr.scene = two_bodies();
   RunRecord r = run_engine(sr.scene, fake(Fault::None), RunOptions{});
-  r.metrics["energy_drift"] = energy_drift;
-  r.metrics["position_divergence"] = position_divergence;
+  r.metrics["energy_drift"] = 3e-6;
+  r.metrics["position_divergence"] = 1e-3;
   sr.runs = {r};
   result.scenarios.push_back(sr);
-  return result;
-}
-const nlohmann::json kBaseline = {
-    {"runs", {{{"scenario", "two"}, {"engine", "fake"}, {"metrics", {{"energy_drift", 1e-6}, {"position_divergence", 1e-3}}}}}}};
-
-TEST(Gate, BaselineFailsOnRegressionBeyondFactor) {
-  SuiteResult result = suite_with(3e-6, 1e-3);
-  EXPECT_EQ(apply_baseline(result, kBaseline, 2.0), 1);
+  const nlohmann::json baseline = {
+      {"runs", {{{"scenario", "two"}, {"engine", "fake"}, {"metrics", {{"energy_drift", 1e-6}, {"position_divergence", 1e-3}}}}}}};
+  EXPECT_EQ(apply_baseline(result, baseline, 2.0), 1);
   const auto& checks = result.scenarios[0].runs[0].checks;
   ASSERT_EQ(checks.size(), 2u);
   for (const Check& c : checks) {
@@ -371,14 +364,21 @@ TEST(Gate, BaselineFailsOnRegressionBeyondFactor) {
 // A metric the baseline measured and this run did not (null: a reference that stopped
 // converging, say) hid every regression in it: the check passed by being skipped.
 TEST(Gate, BaselineFailsWhenAMeasuredMetricIsNoLongerMeasured) {
-  SuiteResult result = suite_with(1e-6, std::nullopt);
-  EXPECT_EQ(apply_baseline(result, kBaseline, 2.0), 1);
+  SuiteResult result;
+  ScenarioResult sr;
+  sr.scene = two_bodies();
+  RunRecord r = run_engine(sr.scene, fake(Fault::None), RunOptions{});
+  r.metrics["energy_drift"] = 1e-6;
+  r.metrics["position_divergence"] = std::nullopt;
+  sr.runs = {r};
+  result.scenarios.push_back(sr);
+  const nlohmann::json baseline = {
+      {"runs", {{{"scenario", "two"}, {"engine", "fake"}, {"metrics", {{"energy_drift", 1e-6}, {"position_divergence", 1e-3}}}}}}};
+  EXPECT_EQ(apply_baseline(result, baseline, 2.0), 1);
   const auto& checks = result.scenarios[0].runs[0].checks;
   ASSERT_EQ(checks.size(), 2u);
   for (const Check& c : checks) {
-    if (c.what == "baseline.energy_drift") {
-      EXPECT_TRUE(c.pass);
-    }
+    if (c.what == "baseline.energy_drift") EXPECT_TRUE(c.pass);
     if (c.what == "baseline.position_divergence") {
       EXPECT_FALSE(c.pass);
       EXPECT_FALSE(c.value.has_value());
