@@ -21,13 +21,15 @@
 // particles are left to the pairwise path.
 //
 // With friction the set is solved by projected Jacobi, and every body's velocity change
-// is summed exactly from its impulses, so the answer is the same to the last bit for
-// every numbering of the bodies and exactly mirrored in a mirrored scene; a friction set
+// is summed from its impulses in an order fixed by the geometry (exactly, for the
+// velocities applied), so the answer is the same to the last bit for every numbering of
+// the bodies and exactly mirrored in a mirrored scene; a friction set
 // whose impulses would raise the kinetic energy is solved again under Moreau's law, then
 // inelastically (see friction_solve below).
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
 #include <vector>
 
 #include "world.hpp"
@@ -479,14 +481,94 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       }
     }
   }
-  // dv from the impulses p, each body's terms summed exactly (exact_sum): the same
-  // whatever order the rows are in, and exactly mirrored in a mirrored scene.
-  const auto recompute_dv = [&]() {
+  // Each body's terms in an order fixed by the geometry alone: by the direction of its
+  // contact's normal seen from the body (u = sign * n) as the key (u.y, |u.x|), which a
+  // mirror x -> -x leaves as it is and a renumbering does not touch (n and the sign flip
+  // together).
+  // Terms with equal keys (the two sides of a mirror pair, or a face's tangent along
+  // another contact's normal) form a group that is added up first by itself (a + b,
+  // commutative; three or more: exact_sum), so the plain running sum over the groups is
+  // the same double for every numbering and exactly mirrored in a mirrored scene. This
+  // is what the Jacobi sweeps use (an exact sum per body and sweep was half of a pile's
+  // run); the velocities applied are summed exactly once at the end.
+  thread_local std::vector<std::uint32_t> term_glen;
+  term_glen.assign(term_row.size(), 0);
+  {
+    // A tangent row is keyed by its contact's normal (its own d flips in a mirror image)
+    // and comes after it.
+    const auto key = [&](std::uint32_t f) {
+      const std::uint32_t k = term_row[f];
+      const Vec2 n = rows[k].tangent ? rows[k - 1].d : rows[k].d;
+      return std::tuple<double, double, bool>{term_sign[f] * n.y, std::fabs(n.x), rows[k].tangent};
+    };
+    thread_local std::vector<std::uint32_t> idx;
+    thread_local std::vector<std::uint32_t> tr;
+    thread_local std::vector<double> ts;
+    for (std::size_t s = 0; s < bodies.size(); ++s) {
+      const std::uint32_t b0 = term_start[s], b1 = term_start[s + 1];
+      idx.resize(b1 - b0);
+      for (std::uint32_t f = b0; f < b1; ++f) idx[f - b0] = f;
+      std::sort(idx.begin(), idx.end(), [&](std::uint32_t x, std::uint32_t y) { return key(x) < key(y); });
+      tr.resize(b1 - b0);
+      ts.resize(b1 - b0);
+      for (std::uint32_t f = b0; f < b1; ++f) {
+        tr[f - b0] = term_row[idx[f - b0]];
+        ts[f - b0] = term_sign[idx[f - b0]];
+      }
+      std::copy(tr.begin(), tr.end(), term_row.begin() + b0);
+      std::copy(ts.begin(), ts.end(), term_sign.begin() + b0);
+      for (std::uint32_t f = b0; f < b1;) {
+        std::uint32_t g = f + 1;
+        while (g < b1 && key(g) == key(f)) ++g;
+        term_glen[f] = g - f;
+        f = g;
+      }
+    }
+  }
+  // dv from the impulses p: each body's terms summed in the order above (exactly = false,
+  // the sweeps) or exactly (exact_sum: the correctly rounded sum, for the velocities
+  // applied and the energy check). Either is the same whatever order the rows are in,
+  // and exactly mirrored in a mirrored scene.
+  const auto recompute_dv = [&](bool exactly) {
     for (std::size_t s = 0; s < bodies.size(); ++s) {
       const std::uint32_t b0 = term_start[s], b1 = term_start[s + 1];
       const double m = inv(bodies[s]);
       if (!(m > 0.0)) {
         dv[s] = {};
+        continue;
+      }
+      if (!exactly) {
+        double sx = 0.0, sy = 0.0;
+        for (std::uint32_t f = b0; f < b1;) {
+          const std::uint32_t g = term_glen[f];
+          double gx, gy;
+          if (g == 1) {
+            const Vec2 d = rows[term_row[f]].d;
+            const double imp = term_sign[f] * (p[term_row[f]] * m);
+            gx = imp * d.x;
+            gy = imp * d.y;
+          } else if (g == 2) {
+            const Vec2 d0 = rows[term_row[f]].d, d1 = rows[term_row[f + 1]].d;
+            const double q0 = term_sign[f] * (p[term_row[f]] * m), q1 = term_sign[f + 1] * (p[term_row[f + 1]] * m);
+            gx = q0 * d0.x + q1 * d1.x;
+            gy = q0 * d0.y + q1 * d1.y;
+          } else {
+            sum_x.resize(g);
+            sum_y.resize(g);
+            for (std::uint32_t h = 0; h < g; ++h) {
+              const Vec2 d = rows[term_row[f + h]].d;
+              const double imp = term_sign[f + h] * (p[term_row[f + h]] * m);
+              sum_x[h] = imp * d.x;
+              sum_y[h] = imp * d.y;
+            }
+            gx = exact_sum(sum_x.data(), g);
+            gy = exact_sum(sum_y.data(), g);
+          }
+          sx += gx;
+          sy += gy;
+          f += g;
+        }
+        dv[s] = {sx, sy};
         continue;
       }
       // Only the rows with an impulse (most are often 0): a body with two pays a plain sum.
@@ -564,7 +646,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
         p[k] = pnew[k];
         pmax = std::max(pmax, std::fabs(p[k]));
       }
-      recompute_dv();
+      recompute_dv(false);
       if (change <= stop * pmax) break;
     }
     // A contact whose friction could not stop it slides: kinetic friction, mu_k p_n.
@@ -576,7 +658,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
         p[k] = std::copysign(c.mu_k * p[k - 1], p[k]);
       }
     }
-    recompute_dv();
+    recompute_dv(true);
   };
   // Whether the impulses p raise the set's kinetic energy (beyond round-off), summed
   // exactly so that the answer does not depend on the numbering either.
@@ -646,7 +728,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     if (c.p * (inv(c.a) + inv(c.b)) > kGapUlps * kEps * c.vscale) impacted.push_back({c.a, c.b});
   }
   // Each body's velocity change summed exactly from all its impulses.
-  recompute_dv();
+  recompute_dv(true);
   for (std::size_t s = 0; s < bodies.size(); ++s) {
     if (inv(bodies[s]) > 0.0) w.vel[bodies[s]] += dv[s];
   }
