@@ -590,27 +590,36 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   // With friction the solutions can form a family (a ball wedged on two that slide: how
   // the wedge shares its weight is free), and Gauss-Seidel picks one by the order of
   // its rows, i.e. by the body numbering. So friction sets are solved by projected
-  // Jacobi: every row is updated from the same velocities, with its step divided by the
-  // number of rows on its busiest body (mass splitting, which keeps the sweep stable),
+  // Jacobi: every row is updated from the same velocities, with its step damped by
+  // omega_k (below: a Gershgorin bound, which keeps the sweep stable),
   // and tangential impulses kept within mu_s p_n; the velocities are then summed again
   // from all the impulses (recompute_dv). Renumbering the bodies permutes the rows and
   // nothing else, and a mirrored scene gives exactly the mirrored iterates.
   thread_local std::vector<double> omega, pnew;
-  thread_local std::vector<std::int32_t> rows_on;
+  thread_local std::vector<double> off_terms;
   if (friction) {
-    rows_on.assign(bodies.size(), 0);
-    for (std::size_t k = 0; k < R; ++k) {
-      if (rows[k].tangent) continue;   // a contact's own two rows are orthogonal: count it once
-      if (slot_a[k] >= 0) ++rows_on[static_cast<std::size_t>(slot_a[k])];
-      if (slot_b[k] >= 0) ++rows_on[static_cast<std::size_t>(slot_b[k])];
-    }
+    // Row k's step omega_k: Gershgorin on 2 D / Omega - A, which stays positive definite
+    // (so the damped sweep converges) when (2 / omega_k - 1) A_kk > S_k = sum over l != k
+    // of |A_kl|; omega_k is 0.95 of that bound, at most 1. A_kl comes from the bodies
+    // rows k and l share and can move (a fixed body couples nothing): inv_m d_k.d_l.
+    // S_k is summed exactly (the same for every numbering; |d_k.d_l| is mirror-exact).
     omega.assign(R, 1.0);
     for (std::size_t k = 0; k < R; ++k) {
-      std::int32_t n = 1;
-      if (slot_a[k] >= 0) n = std::max(n, rows_on[static_cast<std::size_t>(slot_a[k])]);
-      if (slot_b[k] >= 0) n = std::max(n, rows_on[static_cast<std::size_t>(slot_b[k])]);
-      // Gershgorin: 2 D / omega - A stays positive definite, so the damped sweep converges.
-      omega[k] = std::min(1.0, 1.9 / (1.0 + std::sqrt(2.0) * static_cast<double>(n - 1)));
+      off_terms.clear();
+      for (const std::int32_t sl : {slot_a[k], slot_b[k]}) {
+        if (sl < 0) continue;
+        const std::size_t s = static_cast<std::size_t>(sl);
+        const double m = inv(bodies[s]);
+        if (!(m > 0.0)) continue;
+        for (std::uint32_t f = term_start[s]; f < term_start[s + 1]; ++f) {
+          const std::uint32_t l = term_row[f];
+          if (l == k) continue;
+          off_terms.push_back(std::fabs(m * dot(rows[k].d, rows[l].d)));
+        }
+      }
+      const double S = exact_sum(off_terms.data(), off_terms.size());
+      const double akk = A[k];
+      if (akk > 0.0) omega[k] = std::min(1.0, 0.95 * (2.0 * akk) / (akk + S));
     }
     pnew.assign(R, 0.0);
   }
