@@ -492,6 +492,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   // is what the Jacobi sweeps use (an exact sum per body and sweep was half of a pile's
   // run); the velocities applied are summed exactly once at the end.
   thread_local std::vector<std::uint32_t> term_glen;
+  thread_local std::vector<Vec2> term_d;
   term_glen.assign(term_row.size(), 0);
   {
     // A tangent row is keyed by its contact's normal (its own d flips in a mirror image)
@@ -524,6 +525,8 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
         f = g;
       }
     }
+    term_d.resize(term_row.size());
+    for (std::size_t f = 0; f < term_row.size(); ++f) term_d[f] = term_sign[f] * rows[term_row[f]].d;
   }
   // dv from the impulses p: each body's terms summed in the order above (exactly = false,
   // the sweeps) or exactly (exact_sum: the correctly rounded sum, for the velocities
@@ -538,18 +541,19 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
         continue;
       }
       if (!exactly) {
+        // term_d = sign * d, so (p m) term_d is sign (p m) d exactly (the sign is +-1).
         double sx = 0.0, sy = 0.0;
         for (std::uint32_t f = b0; f < b1;) {
           const std::uint32_t g = term_glen[f];
           double gx, gy;
           if (g == 1) {
-            const Vec2 d = rows[term_row[f]].d;
-            const double imp = term_sign[f] * (p[term_row[f]] * m);
+            const Vec2 d = term_d[f];
+            const double imp = p[term_row[f]] * m;
             gx = imp * d.x;
             gy = imp * d.y;
           } else if (g == 2) {
-            const Vec2 d0 = rows[term_row[f]].d, d1 = rows[term_row[f + 1]].d;
-            const double q0 = term_sign[f] * (p[term_row[f]] * m), q1 = term_sign[f + 1] * (p[term_row[f + 1]] * m);
+            const Vec2 d0 = term_d[f], d1 = term_d[f + 1];
+            const double q0 = p[term_row[f]] * m, q1 = p[term_row[f + 1]] * m;
             gx = q0 * d0.x + q1 * d1.x;
             gy = q0 * d0.y + q1 * d1.y;
           } else {
@@ -596,28 +600,39 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   // from all the impulses (recompute_dv). Renumbering the bodies permutes the rows and
   // nothing else, and a mirrored scene gives exactly the mirrored iterates.
   thread_local std::vector<double> omega, pnew;
-  thread_local std::vector<double> off_terms;
+  struct SweepRow {
+    Vec2 d;
+    std::int32_t sa, sb;
+    double w0, akk, omega, mu, target;
+    bool tangent;
+  };
+  thread_local std::vector<SweepRow> sweep;
   if (friction) {
     // Row k's step omega_k: Gershgorin on 2 D / Omega - A, which stays positive definite
     // (so the damped sweep converges) when (2 / omega_k - 1) A_kk > S_k = sum over l != k
     // of |A_kl|; omega_k is 0.95 of that bound, at most 1. A_kl comes from the bodies
     // rows k and l share and can move (a fixed body couples nothing): inv_m d_k.d_l.
-    // S_k is summed exactly (the same for every numbering; |d_k.d_l| is mirror-exact).
+    // |d_k.d_l| is mirror-exact.
     omega.assign(R, 1.0);
     for (std::size_t k = 0; k < R; ++k) {
-      off_terms.clear();
+      // Each body's part in its terms' order (fixed by the geometry, above), the two
+      // parts then added (commutative): the same for every numbering.
+      double part[2] = {0.0, 0.0};
+      int np = 0;
       for (const std::int32_t sl : {slot_a[k], slot_b[k]}) {
         if (sl < 0) continue;
         const std::size_t s = static_cast<std::size_t>(sl);
         const double m = inv(bodies[s]);
         if (!(m > 0.0)) continue;
+        double sum = 0.0;
         for (std::uint32_t f = term_start[s]; f < term_start[s + 1]; ++f) {
           const std::uint32_t l = term_row[f];
           if (l == k) continue;
-          off_terms.push_back(std::fabs(m * dot(rows[k].d, rows[l].d)));
+          sum += std::fabs(m * dot(rows[k].d, rows[l].d));
         }
+        part[np++] = sum;
       }
-      const double S = exact_sum(off_terms.data(), off_terms.size());
+      const double S = part[0] + part[1];
       const double akk = A[k];
       if (akk > 0.0) omega[k] = std::min(1.0, 0.95 * (2.0 * akk) / (akk + S));
     }
@@ -630,31 +645,46 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     p.assign(R, 0.0);
     dv.assign(bodies.size(), Vec2{});
     pmax = 0.0;
+    // The rows' data packed for the sweep (the same arithmetic as row by row from rows[]
+    // and contacts[]).
+    sweep.resize(R);
+    for (std::size_t k = 0; k < R; ++k) {
+      const Row& rk = rows[k];
+      const Contact& c = contacts[rk.contact];
+      SweepRow& q = sweep[k];
+      q.d = rk.d;
+      q.sa = slot_a[k];
+      q.sb = slot_b[k];
+      q.w0 = w0[k];
+      q.akk = A[k];
+      q.omega = omega[k];
+      q.tangent = rk.tangent;
+      q.mu = c.mu_s;
+      q.target = rk.tangent ? (law == 1 ? c.e * w0[k] : 0.0) : (law == 2 ? 0.0 : c.target);
+    }
     for (int iter = 0; iter < max_iter; ++iter) {
       double change = 0.0;
       for (std::size_t k = 0; k < R; ++k) {
-        pnew[k] = p[k];
-        const double akk = A[k];
-        if (!(akk > 0.0)) continue;
-        const Row& rk = rows[k];
-        const Contact& c = contacts[rk.contact];
-        const Vec2 da = slot_a[k] >= 0 ? dv[static_cast<std::size_t>(slot_a[k])] : Vec2{};
-        const Vec2 db = slot_b[k] >= 0 ? dv[static_cast<std::size_t>(slot_b[k])] : Vec2{};
-        const double wk = w0[k] + dot(db - da, rk.d);
-        if (rk.tangent) {
-          const double bound = c.mu_s * p[k - 1];
-          const double xi = law == 1 ? wk + c.e * w0[k] : wk;
-          pnew[k] = std::clamp(p[k] - omega[k] * xi / akk, -bound, bound);
-        } else {
-          const double target = law == 2 ? 0.0 : c.target;
-          pnew[k] = std::max(0.0, p[k] + omega[k] * (target - wk) / akk);
+        const SweepRow& q = sweep[k];
+        const double pk = p[k];
+        double pn = pk;
+        if (q.akk > 0.0) {
+          const Vec2 da = q.sa >= 0 ? dv[static_cast<std::size_t>(q.sa)] : Vec2{};
+          const Vec2 db = q.sb >= 0 ? dv[static_cast<std::size_t>(q.sb)] : Vec2{};
+          const double wk = q.w0 + dot(db - da, q.d);
+          if (q.tangent) {
+            const double bound = q.mu * p[k - 1];
+            const double xi = wk + q.target;   // law 1: w_t+ + e w_t-; else + 0 (exact)
+            pn = std::clamp(pk - q.omega * xi / q.akk, -bound, bound);
+          } else {
+            pn = std::max(0.0, pk + q.omega * (q.target - wk) / q.akk);
+          }
         }
+        pnew[k] = pn;
+        change = std::max(change, std::fabs(pn - pk));
+        pmax = std::max(pmax, std::fabs(pn));
       }
-      for (std::size_t k = 0; k < R; ++k) {
-        change = std::max(change, std::fabs(pnew[k] - p[k]));
-        p[k] = pnew[k];
-        pmax = std::max(pmax, std::fabs(p[k]));
-      }
+      p.swap(pnew);
       recompute_dv(false);
       if (change <= stop * pmax) break;
     }
@@ -736,8 +766,9 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     // meets again at once through round-off, and takes an impulse of that size).
     if (c.p * (inv(c.a) + inv(c.b)) > kGapUlps * kEps * c.vscale) impacted.push_back({c.a, c.b});
   }
-  // Each body's velocity change summed exactly from all its impulses.
-  recompute_dv(true);
+  // Each body's velocity change summed exactly from all its impulses (a friction set's
+  // friction_solve has just done so).
+  if (!friction) recompute_dv(true);
   for (std::size_t s = 0; s < bodies.size(); ++s) {
     if (inv(bodies[s]) > 0.0) w.vel[bodies[s]] += dv[s];
   }
