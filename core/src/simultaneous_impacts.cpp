@@ -532,10 +532,15 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   // the sweeps) or exactly (exact_sum: the correctly rounded sum, for the velocities
   // applied and the energy check). Either is the same whatever order the rows are in,
   // and exactly mirrored in a mirrored scene.
+  // Each body's inverse mass in this impact (0 for one that cannot move), looked up once:
+  // the sweeps read it for every body in every sweep.
+  thread_local std::vector<double> slot_inv;
+  slot_inv.resize(bodies.size());
+  for (std::size_t s = 0; s < bodies.size(); ++s) slot_inv[s] = inv(bodies[s]);
   const auto recompute_dv = [&](bool exactly) {
     for (std::size_t s = 0; s < bodies.size(); ++s) {
       const std::uint32_t b0 = term_start[s], b1 = term_start[s + 1];
-      const double m = inv(bodies[s]);
+      const double m = slot_inv[s];
       if (!(m > 0.0)) {
         dv[s] = {};
         continue;
