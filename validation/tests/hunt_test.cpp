@@ -255,7 +255,7 @@ void expect_core_meets(const char* file) {
 
 TEST(Hunt, CoreMeetsTheHuntsVTroughClosedForm) { expect_core_meets("v_trough_inelastic.toml"); }
 
-TEST(Hunt, DISABLED_CoreMeetsThePointOnFloorClosedForm) { expect_core_meets("point_on_floor_exact.toml"); }
+TEST(Hunt, CoreMeetsThePointOnFloorClosedForm) { expect_core_meets("point_on_floor_exact.toml"); }
 
 }  // namespace
 }  // namespace physval
