@@ -270,11 +270,24 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
     const double hi = std::max(xi.x, before(i).x) + ri;
     const double ylo = sorted_ylo_[p], yhi = sorted_yhi_[p];
     const std::size_t gi = body_group_[i] * n_body_groups_;
-    for (std::size_t q = p + 1; q < n && sorted_lo_[q] <= hi; ++q) {
-      // The swept y intervals farther apart than the radii together could be (max_radius_
-      // bounds rj) or j not alive (NaN): skipped without touching anything else of j.
-      const double reach = (ri + max_radius_) * (1.0 + 1e-9);
-      if (!(sorted_ylo_[q] <= yhi + reach && sorted_yhi_[q] >= ylo - reach)) continue;
+    // The bodies after i in x order whose box starts before i's ends, filtered by the swept
+    // y intervals: farther apart than the radii together could be (max_radius_ bounds rj)
+    // or j not alive (NaN) is skipped without touching anything else of j. The filter is
+    // branch-free (each index is written, the count advanced by the test), since in a gas
+    // it fails unpredictably for most of the x neighbours; the survivors are then taken
+    // in the same order as before.
+    const double reach = (ri + max_radius_) * (1.0 + 1e-9);
+    const double y_lo = ylo - reach, y_hi = yhi + reach;
+    std::size_t q_end = p + 1;
+    while (q_end < n && sorted_lo_[q_end] <= hi) ++q_end;
+    if (near_.size() < q_end - p) near_.resize(q_end - p);
+    std::size_t found = 0;
+    for (std::size_t q = p + 1; q < q_end; ++q) {
+      near_[found] = static_cast<std::uint32_t>(q);
+      found += static_cast<std::size_t>((sorted_ylo_[q] <= y_hi) & (sorted_yhi_[q] >= y_lo));
+    }
+    for (std::size_t f = 0; f < found; ++f) {
+      const std::size_t q = near_[f];
       const std::size_t j = order_[q];
       const double rj = radius_[j];
       // The same with j's own radius (a margin far above rounding): the centres stayed
