@@ -54,6 +54,35 @@ void BM_ComparePairContactHeavy(benchmark::State& state) {
 }
 BENCHMARK(BM_ComparePairContactHeavy)->Arg(1000)->Arg(10000)->Arg(40000)->Unit(benchmark::kMillisecond);
 
+// What run_suite does for one contact-heavy scene of five engines: each run against the
+// reference, then the ten pairs, through one ScenarioComparer (the contacts' pair ids and
+// the scales computed once per run).
+void BM_ScenarioComparisonsContactHeavy(benchmark::State& state) {
+  const auto contacts = static_cast<std::size_t>(state.range(0));
+  const std::size_t bodies = 1000, samples = 100;
+  Scene scene;
+  scene.name = "gas";
+  scene.dt = 1.0 / 240.0;
+  scene.duration = 4.0;
+  Reference reference;
+  reference.available = reference.converged = true;
+  reference.dt = scene.dt / 8.0;
+  reference.run = gas_run("reference", bodies, contacts, samples, 1);
+  std::vector<RunRecord> runs;
+  for (unsigned e = 0; e < 5; ++e) runs.push_back(gas_run("engine" + std::to_string(e), bodies, contacts, samples, 1 + e % 2));
+  for (auto _ : state) {
+    ScenarioComparer comparer(scene, reference);
+    for (RunRecord& r : runs) comparer.compare_run(r, false);
+    std::vector<PairComparison> pairs;
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      for (std::size_t j = i + 1; j < runs.size(); ++j) pairs.push_back(comparer.compare_pair(runs[i], runs[j]));
+    }
+    benchmark::DoNotOptimize(pairs);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(15 * contacts));
+}
+BENCHMARK(BM_ScenarioComparisonsContactHeavy)->Arg(10000)->Arg(30000)->Unit(benchmark::kMillisecond);
+
 }  // namespace
 }  // namespace physval
 
