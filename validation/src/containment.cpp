@@ -254,6 +254,8 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
   sorted_lo_.resize(n);
   sorted_ylo_.resize(n);
   sorted_yhi_.resize(n);
+  sorted_y_.resize(n);
+  if (near_.size() < n) near_.resize(n);
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t p = 0; p < n; ++p) {
     const std::size_t i = order_[p];
@@ -261,6 +263,7 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
     const double y0 = before(i).y, y1 = pos_[i].y;
     sorted_ylo_[p] = alive_[i] ? std::min(y0, y1) : kNaN;
     sorted_yhi_[p] = alive_[i] ? std::max(y0, y1) : kNaN;
+    sorted_y_[p] = {sorted_ylo_[p], sorted_yhi_[p]};
   }
   for (std::size_t p = 0; p < n; ++p) {
     const std::size_t i = order_[p];
@@ -278,13 +281,10 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
     // in the same order as before.
     const double reach = (ri + max_radius_) * (1.0 + 1e-9);
     const double y_lo = ylo - reach, y_hi = yhi + reach;
-    std::size_t q_end = p + 1;
-    while (q_end < n && sorted_lo_[q_end] <= hi) ++q_end;
-    if (near_.size() < q_end - p) near_.resize(q_end - p);
     std::size_t found = 0;
-    for (std::size_t q = p + 1; q < q_end; ++q) {
+    for (std::size_t q = p + 1; q < n && sorted_lo_[q] <= hi; ++q) {
       near_[found] = static_cast<std::uint32_t>(q);
-      found += static_cast<std::size_t>((sorted_ylo_[q] <= y_hi) & (sorted_yhi_[q] >= y_lo));
+      found += static_cast<std::size_t>((sorted_y_[q].lo <= y_hi) & (sorted_y_[q].hi >= y_lo));
     }
     for (std::size_t f = 0; f < found; ++f) {
       const std::size_t q = near_[f];
