@@ -67,11 +67,11 @@ class ContainmentMonitor {
   std::vector<Vec2> pos_;
   std::vector<char> alive_;
   // lo_ and the y interval swept over the step (NaN: not alive), in order_'s order
-  std::vector<double> sorted_lo_, sorted_ylo_, sorted_yhi_;
+  std::vector<double> sorted_lo_;
   struct YRange {
     double lo, hi;
   };
-  std::vector<YRange> sorted_y_;              // sorted_ylo_ and sorted_yhi_ side by side, for the scan
+  std::vector<YRange> sorted_y_;
   std::vector<std::uint32_t> near_;           // observe's scratch: one body's candidates
   double max_radius_ = 0.0;                    // of the moving bodies
   std::vector<std::uint32_t> on_line_count_;   // on_line_ entries of the body
