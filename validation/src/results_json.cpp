@@ -254,7 +254,14 @@ namespace {
 void write_scene_geometry(std::ostream& os, const ScenarioResult& sr) {
   auto text = [](const std::string& v) { return json(v).dump(); };
   auto number = [](double v) { return json(v).dump(); };
-  auto point = [&](Vec2 p) { return "[" + number(p.x) + ", " + number(p.y) + "]"; };
+  auto point = [&](Vec2 p) {
+    std::string s = "[";  // appended, not "[" + ...: GCC 12's -Wrestrict false positive
+    s += number(p.x);
+    s += ", ";
+    s += number(p.y);
+    s += ']';
+    return s;
+  };
   os << "{\n \"scenario\": " << text(sr.scene.name) << ",\n \"duration\": " << number(sr.scene.duration)
      << ",\n \"dt\": " << number(sr.scene.dt) << ",\n \"bodies\": [";
   // Every body any run had (particles appear in the runs only), in first-seen order.
