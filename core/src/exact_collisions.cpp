@@ -274,7 +274,7 @@ class EventLoop {
     start_substep(w_, i, t, T_);
     // Others find i through its registered box (grown to cover the new path); i's own
     // new events can only be with bodies whose registered boxes meet its new path.
-    const Aabb box = path_box(w_, i, t, T_);
+    const Aabb box = found ? found_box_i_ : path_box(w_, i, t, T_);
     w_.bp->grow(i, box);
     if (found) {
       for (std::uint32_t j : w_.found) {
@@ -302,7 +302,9 @@ class EventLoop {
     }
     start_substep(w_, i, t, T_);
     start_substep(w_, j, t, T_);
-    const Aabb box_i = path_box(w_, i, t, T_), box_j = path_box(w_, j, t, T_);
+    // (found: isolated_pair has the boxes already; no sub-steps there, nothing changed since)
+    const Aabb box_i = found ? found_box_i_ : path_box(w_, i, t, T_);
+    const Aabb box_j = found ? found_box_j_ : path_box(w_, j, t, T_);
     w_.bp->grow(i, box_i);
     w_.bp->grow(j, box_j);
     if (!found) {
@@ -330,7 +332,8 @@ class EventLoop {
   // contact only and it defers to the pairwise law. Leaves in w_.found the bodies whose
   // registered boxes meet the pair's new paths' boxes (and more), for reschedule_pair.
   bool isolated_pair(std::uint32_t i, std::uint32_t j, double t) {
-    const Aabb box_i = path_box(w_, i, t, T_), box_j = path_box(w_, j, t, T_);
+    const Aabb box_i = found_box_i_ = path_box(w_, i, t, T_);
+    const Aabb box_j = found_box_j_ = path_box(w_, j, t, T_);
     const Vec2 pi = w_.pos_at(i, t), pj = w_.pos_at(j, t);
     const Aabb q = merge(merge(box_i, box_j), merge(near_box(pi, w_.radius[i]), near_box(pj, w_.radius[j])));
     w_.found.clear();
@@ -358,7 +361,8 @@ class EventLoop {
     const Vec2 p = w_.pos_at(i, t);
     const double r = w_.radius[i];
     w_.found.clear();
-    w_.bp->query_box(merge(path_box(w_, i, t, T_), near_box(p, r)), i, w_.found);
+    found_box_i_ = path_box(w_, i, t, T_);
+    w_.bp->query_box(merge(found_box_i_, near_box(p, r)), i, w_.found);
     for (std::uint32_t x : w_.found) prefetch_body(x);
     for (std::uint32_t x : w_.found) {
       if (near_body(p, r, w_.pos_at(x, t), w_.radius[x])) return false;
@@ -851,6 +855,7 @@ class EventLoop {
   // Free flight, no collision rules, the simultaneous law: an impact with nothing else
   // near is the pairwise law's, proven without the touching set (isolated_pair).
   const bool fast_isolated_;
+  Aabb found_box_i_, found_box_j_;   // the new paths' boxes isolated_pair/_static found
   std::vector<std::uint32_t> set_;      // the touching set of a simultaneous impact
   std::vector<BodyPair> impacted_;      // its pairs that took an impulse
   std::vector<std::uint32_t> near_;     // bodies near one being held
