@@ -246,7 +246,7 @@ class EventLoop {
         if (!r.collide && is_passing(w_, static_key(i, k))) continue;
       }
       const toi::SegmentHit hit =
-          toi::circle_segment(p, v, a, w_.radius[i], seg.from, seg.to, T_ - t, w_.length_scale);
+          toi::circle_segment(p, v, a, w_.radius[i], seg.from, seg.to, T_ - t, w_.length_scale, w_.force_acc(i));
       if (hit.s == toi::kNever || (k == own_face && !hit.cap)) continue;
       push(Event::make(t + hit.s, i, k, w_.version[i], 0, EventKind::Static, hit.cap ? 1 : 0));
     }
@@ -730,7 +730,7 @@ class EventLoop {
       double side;
       if (D > tiny) side = 1.0;
       else if (D < -tiny) side = -1.0;
-      else side = dot(w_.vel[i], seg.normal) < 0.0 ? 1.0 : -1.0;
+      else side = toi::line_side(0.0, dot(w_.vel[i], seg.normal), dot(w_.force_acc(i), seg.normal));
       n = side * seg.normal;
     } else {
       const double u = dot(p - seg.from, seg.dir);

@@ -21,13 +21,15 @@
 // particles are left to the pairwise path.
 //
 // With friction the set is solved by projected Jacobi, and every body's velocity change
-// is summed exactly from its impulses, so the answer is the same to the last bit for
-// every numbering of the bodies and exactly mirrored in a mirrored scene; a friction set
+// is summed from its impulses in an order fixed by the geometry (exactly, for the
+// velocities applied), so the answer is the same to the last bit for every numbering of
+// the bodies and exactly mirrored in a mirrored scene; a friction set
 // whose impulses would raise the kinetic energy is solved again under Moreau's law, then
 // inelastically (see friction_solve below).
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
 #include <vector>
 
 #include "world.hpp"
@@ -479,14 +481,98 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       }
     }
   }
-  // dv from the impulses p, each body's terms summed exactly (exact_sum): the same
-  // whatever order the rows are in, and exactly mirrored in a mirrored scene.
-  const auto recompute_dv = [&]() {
+  // Each body's terms in an order fixed by the geometry alone: by the direction of its
+  // contact's normal seen from the body (u = sign * n) as the key (u.y, |u.x|), which a
+  // mirror x -> -x leaves as it is and a renumbering does not touch (n and the sign flip
+  // together).
+  // Terms with equal keys (the two sides of a mirror pair, or a face's tangent along
+  // another contact's normal) form a group that is added up first by itself (a + b,
+  // commutative; three or more: exact_sum), so the plain running sum over the groups is
+  // the same double for every numbering and exactly mirrored in a mirrored scene. This
+  // is what the Jacobi sweeps use (an exact sum per body and sweep was half of a pile's
+  // run); the velocities applied are summed exactly once at the end.
+  thread_local std::vector<std::uint32_t> term_glen;
+  thread_local std::vector<Vec2> term_d;
+  term_glen.assign(term_row.size(), 0);
+  {
+    // A tangent row is keyed by its contact's normal (its own d flips in a mirror image)
+    // and comes after it.
+    const auto key = [&](std::uint32_t f) {
+      const std::uint32_t k = term_row[f];
+      const Vec2 n = rows[k].tangent ? rows[k - 1].d : rows[k].d;
+      return std::tuple<double, double, bool>{term_sign[f] * n.y, std::fabs(n.x), rows[k].tangent};
+    };
+    thread_local std::vector<std::uint32_t> idx;
+    thread_local std::vector<std::uint32_t> tr;
+    thread_local std::vector<double> ts;
+    for (std::size_t s = 0; s < bodies.size(); ++s) {
+      const std::uint32_t b0 = term_start[s], b1 = term_start[s + 1];
+      idx.resize(b1 - b0);
+      for (std::uint32_t f = b0; f < b1; ++f) idx[f - b0] = f;
+      std::sort(idx.begin(), idx.end(), [&](std::uint32_t x, std::uint32_t y) { return key(x) < key(y); });
+      tr.resize(b1 - b0);
+      ts.resize(b1 - b0);
+      for (std::uint32_t f = b0; f < b1; ++f) {
+        tr[f - b0] = term_row[idx[f - b0]];
+        ts[f - b0] = term_sign[idx[f - b0]];
+      }
+      std::copy(tr.begin(), tr.end(), term_row.begin() + b0);
+      std::copy(ts.begin(), ts.end(), term_sign.begin() + b0);
+      for (std::uint32_t f = b0; f < b1;) {
+        std::uint32_t g = f + 1;
+        while (g < b1 && key(g) == key(f)) ++g;
+        term_glen[f] = g - f;
+        f = g;
+      }
+    }
+    term_d.resize(term_row.size());
+    for (std::size_t f = 0; f < term_row.size(); ++f) term_d[f] = term_sign[f] * rows[term_row[f]].d;
+  }
+  // dv from the impulses p: each body's terms summed in the order above (exactly = false,
+  // the sweeps) or exactly (exact_sum: the correctly rounded sum, for the velocities
+  // applied and the energy check). Either is the same whatever order the rows are in,
+  // and exactly mirrored in a mirrored scene.
+  const auto recompute_dv = [&](bool exactly) {
     for (std::size_t s = 0; s < bodies.size(); ++s) {
       const std::uint32_t b0 = term_start[s], b1 = term_start[s + 1];
       const double m = inv(bodies[s]);
       if (!(m > 0.0)) {
         dv[s] = {};
+        continue;
+      }
+      if (!exactly) {
+        // term_d = sign * d, so (p m) term_d is sign (p m) d exactly (the sign is +-1).
+        double sx = 0.0, sy = 0.0;
+        for (std::uint32_t f = b0; f < b1;) {
+          const std::uint32_t g = term_glen[f];
+          double gx, gy;
+          if (g == 1) {
+            const Vec2 d = term_d[f];
+            const double imp = p[term_row[f]] * m;
+            gx = imp * d.x;
+            gy = imp * d.y;
+          } else if (g == 2) {
+            const Vec2 d0 = term_d[f], d1 = term_d[f + 1];
+            const double q0 = p[term_row[f]] * m, q1 = p[term_row[f + 1]] * m;
+            gx = q0 * d0.x + q1 * d1.x;
+            gy = q0 * d0.y + q1 * d1.y;
+          } else {
+            sum_x.resize(g);
+            sum_y.resize(g);
+            for (std::uint32_t h = 0; h < g; ++h) {
+              const Vec2 d = rows[term_row[f + h]].d;
+              const double imp = term_sign[f + h] * (p[term_row[f + h]] * m);
+              sum_x[h] = imp * d.x;
+              sum_y[h] = imp * d.y;
+            }
+            gx = exact_sum(sum_x.data(), g);
+            gy = exact_sum(sum_y.data(), g);
+          }
+          sx += gx;
+          sy += gy;
+          f += g;
+        }
+        dv[s] = {sx, sy};
         continue;
       }
       // Only the rows with an impulse (most are often 0): a body with two pays a plain sum.
@@ -508,27 +594,47 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   // With friction the solutions can form a family (a ball wedged on two that slide: how
   // the wedge shares its weight is free), and Gauss-Seidel picks one by the order of
   // its rows, i.e. by the body numbering. So friction sets are solved by projected
-  // Jacobi: every row is updated from the same velocities, with its step divided by the
-  // number of rows on its busiest body (mass splitting, which keeps the sweep stable),
+  // Jacobi: every row is updated from the same velocities, with its step damped by
+  // omega_k (below: a Gershgorin bound, which keeps the sweep stable),
   // and tangential impulses kept within mu_s p_n; the velocities are then summed again
   // from all the impulses (recompute_dv). Renumbering the bodies permutes the rows and
   // nothing else, and a mirrored scene gives exactly the mirrored iterates.
   thread_local std::vector<double> omega, pnew;
-  thread_local std::vector<std::int32_t> rows_on;
+  struct SweepRow {
+    Vec2 d;
+    std::int32_t sa, sb;
+    double w0, akk, omega, mu, target;
+    bool tangent;
+  };
+  thread_local std::vector<SweepRow> sweep;
   if (friction) {
-    rows_on.assign(bodies.size(), 0);
-    for (std::size_t k = 0; k < R; ++k) {
-      if (rows[k].tangent) continue;   // a contact's own two rows are orthogonal: count it once
-      if (slot_a[k] >= 0) ++rows_on[static_cast<std::size_t>(slot_a[k])];
-      if (slot_b[k] >= 0) ++rows_on[static_cast<std::size_t>(slot_b[k])];
-    }
+    // Row k's step omega_k: Gershgorin on 2 D / Omega - A, which stays positive definite
+    // (so the damped sweep converges) when (2 / omega_k - 1) A_kk > S_k = sum over l != k
+    // of |A_kl|; omega_k is 0.95 of that bound, at most 1. A_kl comes from the bodies
+    // rows k and l share and can move (a fixed body couples nothing): inv_m d_k.d_l.
+    // |d_k.d_l| is mirror-exact.
     omega.assign(R, 1.0);
     for (std::size_t k = 0; k < R; ++k) {
-      std::int32_t n = 1;
-      if (slot_a[k] >= 0) n = std::max(n, rows_on[static_cast<std::size_t>(slot_a[k])]);
-      if (slot_b[k] >= 0) n = std::max(n, rows_on[static_cast<std::size_t>(slot_b[k])]);
-      // Gershgorin: 2 D / omega - A stays positive definite, so the damped sweep converges.
-      omega[k] = std::min(1.0, 1.9 / (1.0 + std::sqrt(2.0) * static_cast<double>(n - 1)));
+      // Each body's part in its terms' order (fixed by the geometry, above), the two
+      // parts then added (commutative): the same for every numbering.
+      double part[2] = {0.0, 0.0};
+      int np = 0;
+      for (const std::int32_t sl : {slot_a[k], slot_b[k]}) {
+        if (sl < 0) continue;
+        const std::size_t s = static_cast<std::size_t>(sl);
+        const double m = inv(bodies[s]);
+        if (!(m > 0.0)) continue;
+        double sum = 0.0;
+        for (std::uint32_t f = term_start[s]; f < term_start[s + 1]; ++f) {
+          const std::uint32_t l = term_row[f];
+          if (l == k) continue;
+          sum += std::fabs(m * dot(rows[k].d, rows[l].d));
+        }
+        part[np++] = sum;
+      }
+      const double S = part[0] + part[1];
+      const double akk = A[k];
+      if (akk > 0.0) omega[k] = std::min(1.0, 0.95 * (2.0 * akk) / (akk + S));
     }
     pnew.assign(R, 0.0);
   }
@@ -539,32 +645,47 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     p.assign(R, 0.0);
     dv.assign(bodies.size(), Vec2{});
     pmax = 0.0;
+    // The rows' data packed for the sweep (the same arithmetic as row by row from rows[]
+    // and contacts[]).
+    sweep.resize(R);
+    for (std::size_t k = 0; k < R; ++k) {
+      const Row& rk = rows[k];
+      const Contact& c = contacts[rk.contact];
+      SweepRow& q = sweep[k];
+      q.d = rk.d;
+      q.sa = slot_a[k];
+      q.sb = slot_b[k];
+      q.w0 = w0[k];
+      q.akk = A[k];
+      q.omega = omega[k];
+      q.tangent = rk.tangent;
+      q.mu = c.mu_s;
+      q.target = rk.tangent ? (law == 1 ? c.e * w0[k] : 0.0) : (law == 2 ? 0.0 : c.target);
+    }
     for (int iter = 0; iter < max_iter; ++iter) {
       double change = 0.0;
       for (std::size_t k = 0; k < R; ++k) {
-        pnew[k] = p[k];
-        const double akk = A[k];
-        if (!(akk > 0.0)) continue;
-        const Row& rk = rows[k];
-        const Contact& c = contacts[rk.contact];
-        const Vec2 da = slot_a[k] >= 0 ? dv[static_cast<std::size_t>(slot_a[k])] : Vec2{};
-        const Vec2 db = slot_b[k] >= 0 ? dv[static_cast<std::size_t>(slot_b[k])] : Vec2{};
-        const double wk = w0[k] + dot(db - da, rk.d);
-        if (rk.tangent) {
-          const double bound = c.mu_s * p[k - 1];
-          const double xi = law == 1 ? wk + c.e * w0[k] : wk;
-          pnew[k] = std::clamp(p[k] - omega[k] * xi / akk, -bound, bound);
-        } else {
-          const double target = law == 2 ? 0.0 : c.target;
-          pnew[k] = std::max(0.0, p[k] + omega[k] * (target - wk) / akk);
+        const SweepRow& q = sweep[k];
+        const double pk = p[k];
+        double pn = pk;
+        if (q.akk > 0.0) {
+          const Vec2 da = q.sa >= 0 ? dv[static_cast<std::size_t>(q.sa)] : Vec2{};
+          const Vec2 db = q.sb >= 0 ? dv[static_cast<std::size_t>(q.sb)] : Vec2{};
+          const double wk = q.w0 + dot(db - da, q.d);
+          if (q.tangent) {
+            const double bound = q.mu * p[k - 1];
+            const double xi = wk + q.target;   // law 1: w_t+ + e w_t-; else + 0 (exact)
+            pn = std::clamp(pk - q.omega * xi / q.akk, -bound, bound);
+          } else {
+            pn = std::max(0.0, pk + q.omega * (q.target - wk) / q.akk);
+          }
         }
+        pnew[k] = pn;
+        change = std::max(change, std::fabs(pn - pk));
+        pmax = std::max(pmax, std::fabs(pn));
       }
-      for (std::size_t k = 0; k < R; ++k) {
-        change = std::max(change, std::fabs(pnew[k] - p[k]));
-        p[k] = pnew[k];
-        pmax = std::max(pmax, std::fabs(p[k]));
-      }
-      recompute_dv();
+      p.swap(pnew);
+      recompute_dv(false);
       if (change <= stop * pmax) break;
     }
     // A contact whose friction could not stop it slides: kinetic friction, mu_k p_n.
@@ -576,7 +697,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
         p[k] = std::copysign(c.mu_k * p[k - 1], p[k]);
       }
     }
-    recompute_dv();
+    recompute_dv(true);
   };
   // Whether the impulses p raise the set's kinetic energy (beyond round-off), summed
   // exactly so that the answer does not depend on the numbering either.
@@ -645,8 +766,9 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     // meets again at once through round-off, and takes an impulse of that size).
     if (c.p * (inv(c.a) + inv(c.b)) > kGapUlps * kEps * c.vscale) impacted.push_back({c.a, c.b});
   }
-  // Each body's velocity change summed exactly from all its impulses.
-  recompute_dv();
+  // Each body's velocity change summed exactly from all its impulses (a friction set's
+  // friction_solve has just done so).
+  if (!friction) recompute_dv(true);
   for (std::size_t s = 0; s < bodies.size(); ++s) {
     if (inv(bodies[s]) > 0.0) w.vel[bodies[s]] += dv[s];
   }
