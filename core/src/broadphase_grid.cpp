@@ -165,6 +165,15 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
 
   void pairs(std::vector<BodyPair>& out) override {
     static constexpr std::int32_t kForward[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
+    // The forward neighbours of the last home cell seen: the bodies of a bucket mostly
+    // share one, so its buckets are looked up once per bucket, not once per body.
+    struct Neighbour {
+      std::int32_t x, y;
+      std::uint32_t begin, end;   // its bucket's positions (empty: off the int32 range)
+    };
+    Neighbour near[4];
+    std::int32_t last_x = 0, last_y = 0;
+    bool have_last = false;
     for (std::uint32_t b = 0; b < hash_.buckets; ++b) {
       const std::uint32_t end = start_[b + 1];
       for (std::uint32_t k = start_[b]; k < end; ++k) {
@@ -175,15 +184,26 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
           const Slot& s2 = slots_[k2];
           if (overlaps(a, s2.box) && s2.hx == cx && s2.hy == cy) push(out, sk.body, s2.body);
         }
-        for (const auto& d : kForward) {
-          const std::int64_t nx = static_cast<std::int64_t>(cx) + d[0];
-          const std::int64_t ny = static_cast<std::int64_t>(cy) + d[1];
-          if (nx > 2147483646 || nx < -2147483647 || ny > 2147483646) continue;
-          const auto ncx = static_cast<std::int32_t>(nx), ncy = static_cast<std::int32_t>(ny);
-          const std::uint32_t nb = hash_(ncx, ncy);
-          for (std::uint32_t k2 = start_[nb]; k2 < start_[nb + 1]; ++k2) {
+        if (!have_last || cx != last_x || cy != last_y) {
+          have_last = true;
+          last_x = cx;
+          last_y = cy;
+          for (int d = 0; d < 4; ++d) {
+            const std::int64_t nx = static_cast<std::int64_t>(cx) + kForward[d][0];
+            const std::int64_t ny = static_cast<std::int64_t>(cy) + kForward[d][1];
+            if (nx > 2147483646 || nx < -2147483647 || ny > 2147483646) {
+              near[d] = {0, 0, 0, 0};
+              continue;
+            }
+            const auto ncx = static_cast<std::int32_t>(nx), ncy = static_cast<std::int32_t>(ny);
+            const std::uint32_t nb = hash_(ncx, ncy);
+            near[d] = {ncx, ncy, start_[nb], start_[nb + 1]};
+          }
+        }
+        for (const Neighbour& nd : near) {
+          for (std::uint32_t k2 = nd.begin; k2 < nd.end; ++k2) {
             const Slot& s2 = slots_[k2];
-            if (overlaps(a, s2.box) && s2.hx == ncx && s2.hy == ncy) push(out, sk.body, s2.body);
+            if (overlaps(a, s2.box) && s2.hx == nd.x && s2.hy == nd.y) push(out, sk.body, s2.body);
           }
         }
       }

@@ -57,7 +57,13 @@ double inf_norm(Vec2 v) { return std::max(std::fabs(v.x), std::fabs(v.y)); }
 
 class EventLoop {
  public:
-  EventLoop(World& w, StepContext& ctx) : w_(w), ctx_(ctx), T_(ctx.dt), coupled_(w.coupled()) {}
+  EventLoop(World& w, StepContext& ctx)
+      : w_(w),
+        ctx_(ctx),
+        T_(ctx.dt),
+        coupled_(w.coupled()),
+        fast_isolated_(w.impact_law == ImpactLaw::Simultaneous && !w.any_rules && !w.any_forces && !w.varying_forces &&
+                       !w.coupled()) {}
 
   void run() {
     prune_passing(w_);
@@ -240,7 +246,7 @@ class EventLoop {
         if (!r.collide && is_passing(w_, static_key(i, k))) continue;
       }
       const toi::SegmentHit hit =
-          toi::circle_segment(p, v, a, w_.radius[i], seg.from, seg.to, T_ - t, w_.length_scale);
+          toi::circle_segment(p, v, a, w_.radius[i], seg.from, seg.to, T_ - t, w_.length_scale, w_.force_acc(i));
       if (hit.s == toi::kNever || (k == own_face && !hit.cap)) continue;
       push(Event::make(t + hit.s, i, k, w_.version[i], 0, EventKind::Static, hit.cap ? 1 : 0));
     }
@@ -261,23 +267,33 @@ class EventLoop {
   }
 
   // Body i's path changed at time t: register its new path and find its next events.
-  void reschedule(std::uint32_t i, double t) {
+  // found: w_.found holds already every other body whose registered box overlaps the new
+  // path's (isolated_static asked for a box containing it; the others are filtered out).
+  void reschedule(std::uint32_t i, double t, bool found = false) {
     if (!w_.alive(i)) return;
     start_substep(w_, i, t, T_);
     // Others find i through its registered box (grown to cover the new path); i's own
     // new events can only be with bodies whose registered boxes meet its new path.
-    const Aabb box = path_box(w_, i, t, T_);
+    const Aabb box = found ? found_box_i_ : path_box(w_, i, t, T_);
     w_.bp->grow(i, box);
-    w_.found.clear();
-    w_.bp->query_box(box, i, w_.found);
-    for (std::uint32_t j : w_.found) prefetch_body(j);
-    for (std::uint32_t j : w_.found) schedule_pair(i, j, t);
+    if (found) {
+      for (std::uint32_t j : w_.found) {
+        if (overlaps(box, w_.bp->box(j))) schedule_pair(i, j, t);
+      }
+    } else {
+      w_.found.clear();
+      w_.bp->query_box(box, i, w_.found);
+      for (std::uint32_t j : w_.found) prefetch_body(j);
+      for (std::uint32_t j : w_.found) schedule_pair(i, j, t);
+    }
     if (w_.dynamic(i)) schedule_statics(i, t, box);
     schedule_body(i, t);
   }
 
   // Both bodies of an impact changed their paths: one broad-phase query for the two.
-  void reschedule_pair(std::uint32_t i, std::uint32_t j, double t) {
+  // found: w_.found holds already every body whose registered box overlaps the new paths'
+  // (isolated_pair asked for a box containing them; the others are filtered out below).
+  void reschedule_pair(std::uint32_t i, std::uint32_t j, double t, bool found = false) {
     const bool ai = w_.alive(i), aj = w_.alive(j);
     if (!ai || !aj) {
       if (ai) reschedule(i, t);
@@ -286,12 +302,16 @@ class EventLoop {
     }
     start_substep(w_, i, t, T_);
     start_substep(w_, j, t, T_);
-    const Aabb box_i = path_box(w_, i, t, T_), box_j = path_box(w_, j, t, T_);
+    // (found: isolated_pair has the boxes already; no sub-steps there, nothing changed since)
+    const Aabb box_i = found ? found_box_i_ : path_box(w_, i, t, T_);
+    const Aabb box_j = found ? found_box_j_ : path_box(w_, j, t, T_);
     w_.bp->grow(i, box_i);
     w_.bp->grow(j, box_j);
-    w_.found.clear();
-    w_.bp->query_box(merge(box_i, box_j), kNone, w_.found);
-    for (std::uint32_t k : w_.found) prefetch_body(k);   // all misses at once, not one by one
+    if (!found) {
+      w_.found.clear();
+      w_.bp->query_box(merge(box_i, box_j), kNone, w_.found);
+      for (std::uint32_t k : w_.found) prefetch_body(k);   // all misses at once, not one by one
+    }
     for (std::uint32_t k : w_.found) {
       const Aabb& reg_k = w_.bp->box(k);
       if (k != i && overlaps(box_i, reg_k)) schedule_pair(i, k, t);   // includes (i, j)
@@ -301,6 +321,83 @@ class EventLoop {
     if (w_.dynamic(j)) schedule_statics(j, t, box_j);
     schedule_body(i, t);
     schedule_body(j, t);
+  }
+
+  // Whether the simultaneous law can be skipped for the impact of i and j at t (both
+  // advanced to t, their pairwise response applied): no other body and no face within
+  // contact distance of either at t. A superset of the touching set's test: its
+  // candidates are the registered boxes meeting its touch boxes (ours are wider) and
+  // its contacts have gaps within 1024 ulps of the coordinates (ours: 1e-9 of them,
+  // closing or not), so when nothing is near here, its set holds the pair's own
+  // contact only and it defers to the pairwise law. Leaves in w_.found the bodies whose
+  // registered boxes meet the pair's new paths' boxes (and more), for reschedule_pair.
+  bool isolated_pair(std::uint32_t i, std::uint32_t j, double t) {
+    const Aabb box_i = found_box_i_ = path_box(w_, i, t, T_);
+    const Aabb box_j = found_box_j_ = path_box(w_, j, t, T_);
+    const Vec2 pi = w_.pos_at(i, t), pj = w_.pos_at(j, t);
+    const Aabb q = merge(merge(box_i, box_j), merge(near_box(pi, w_.radius[i]), near_box(pj, w_.radius[j])));
+    w_.found.clear();
+    w_.bp->query_box(q, kNone, w_.found);
+    // The pair itself, whose grown boxes the query after the growth always meets.
+    bool has_i = false, has_j = false;
+    for (std::uint32_t k : w_.found) {
+      prefetch_body(k);
+      has_i = has_i || k == i;
+      has_j = has_j || k == j;
+    }
+    if (!has_i) w_.found.push_back(i);
+    if (!has_j) w_.found.push_back(j);
+    for (std::uint32_t k : w_.found) {
+      if (k == i || k == j) continue;
+      const Vec2 pk = w_.pos_at(k, t);
+      if (near_body(pi, w_.radius[i], pk, w_.radius[k]) || near_body(pj, w_.radius[j], pk, w_.radius[k])) return false;
+    }
+    return !near_face(pi, w_.radius[i], kNone) && !near_face(pj, w_.radius[j], kNone);
+  }
+  // isolated_pair for body i meeting face k at t (advanced to t, its response applied).
+  // Leaves in w_.found the other bodies whose registered boxes meet its new path's box
+  // (and more), for reschedule.
+  bool isolated_static(std::uint32_t i, std::uint32_t k, double t) {
+    const Vec2 p = w_.pos_at(i, t);
+    const double r = w_.radius[i];
+    w_.found.clear();
+    found_box_i_ = path_box(w_, i, t, T_);
+    w_.bp->query_box(merge(found_box_i_, near_box(p, r)), i, w_.found);
+    for (std::uint32_t x : w_.found) prefetch_body(x);
+    for (std::uint32_t x : w_.found) {
+      if (near_body(p, r, w_.pos_at(x, t), w_.radius[x])) return false;
+    }
+    return !near_face(p, r, k);
+  }
+  // The touching set's box around a body at p (touch_box in simultaneous_impacts.cpp:
+  // r + 1024 ulps of |p| + 2r + 1), widened to r + 1e-9 (|p| + 2r + 1).
+  static Aabb near_box(Vec2 p, double r) {
+    const double pad = r + 1e-9 * (inf_norm(p) + 2.0 * r + 1.0);
+    return make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad);
+  }
+  // Circles at p (radius r) and q (radius s) closer than contact distance plus 1e-9 of
+  // the coordinates (the touching set's test allows 1024 ulps of them).
+  static bool near_body(Vec2 p, double r, Vec2 q, double s) {
+    const double R = r + s;
+    const double reach = R + 1e-9 * (inf_norm(p) + inf_norm(q) + R);
+    return !(length_squared(q - p) > reach * reach);
+  }
+  // A face other than `except` within contact distance of the circle at p, with the same
+  // slack (the touching set's faces: its pad is r (1 + 1e-9) + 1024 ulps).
+  bool near_face(Vec2 p, double r, std::uint32_t except) {
+    if (w_.statics.segments.empty()) return false;
+    const double pad = r * (1.0 + 1e-6) + 1e-9 * (inf_norm(p) + w_.length_scale);
+    w_.found_static.clear();
+    w_.statics.query(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), w_.found_static);
+    for (std::uint32_t k : w_.found_static) {
+      if (k == except) continue;
+      const Segment& s = w_.statics.segments[k];
+      const double slack = 1e-9 * (inf_norm(p) + r + inf_norm(s.from) + inf_norm(s.to));
+      const double u = dot(p - s.from, s.dir);
+      if (u < -slack || u > s.length + slack) continue;
+      if (!(std::fabs(dot(p - s.from, s.normal)) - r > slack)) return true;
+    }
+    return false;
   }
 
   // A velocity change by another body: a supported body lifted off (or driven into)
@@ -535,7 +632,20 @@ class EventLoop {
     // its set takes every touching contact, separating or not, so that all are solved
     // at once.
     w_.sim_with_separating = cycling;
-    const bool simultaneous = !settled && resolve_simultaneous(w_, i, j, t, set_, impacted_, min_sep);
+    // A gas's impact: free bodies, no forces, nothing else near. The pairwise response is
+    // found first and the broad-phase query for the pair's new paths is asked once, wide
+    // enough to prove that no third body or face touches the pair (then the simultaneous
+    // law would find one contact and defer to the pairwise law): no touching-set gather.
+    bool isolated = false;
+    if (!settled && fast_isolated_ && !cycling && !w_.stationary(i) && !w_.stationary(j)) {
+      resolve_pair(w_, i, j, n, m, min_sep);
+      isolated = isolated_pair(i, j, t);
+      if (!isolated) {   // undone: the touching set decides, as without this shortcut
+        w_.vel[i] = vi_before;
+        w_.vel[j] = vj_before;
+      }
+    }
+    const bool simultaneous = !settled && !isolated && resolve_simultaneous(w_, i, j, t, set_, impacted_, min_sep);
     w_.sim_with_separating = false;
     if (simultaneous) {
       if (wedged()) ++w_.stats.wedged;
@@ -544,7 +654,9 @@ class EventLoop {
     }
     if (!settled) {
       const bool slow = -dot(w_.vel[j] - w_.vel[i], n) < w_.collapse_speed(i, j);
-      if (slow && w_.stationary(j) && !w_.stationary(i)) {
+      if (isolated) {
+        // resolved above (resolve_pair: neither body is stationary)
+      } else if (slow && w_.stationary(j) && !w_.stationary(i)) {
         resolve_static(w_, i, -n, m, min_sep);   // its supports absorb a slow impact
       } else if (slow && w_.stationary(i) && !w_.stationary(j)) {
         resolve_static(w_, j, n, m, min_sep);
@@ -563,7 +675,7 @@ class EventLoop {
     ++w_.version[j];
     destroy_after(i, r.destroy_first);
     destroy_after(j, r.destroy_second);
-    reschedule_pair(i, j, t);
+    reschedule_pair(i, j, t, isolated);
     if (!settled) {
       free_dependents(i, t);
       free_dependents(j, t);
@@ -618,7 +730,7 @@ class EventLoop {
       double side;
       if (D > tiny) side = 1.0;
       else if (D < -tiny) side = -1.0;
-      else side = dot(w_.vel[i], seg.normal) < 0.0 ? 1.0 : -1.0;
+      else side = toi::line_side(0.0, dot(w_.vel[i], seg.normal), dot(w_.force_acc(i), seg.normal));
       n = side * seg.normal;
     } else {
       const double u = dot(p - seg.from, seg.dir);
@@ -641,7 +753,20 @@ class EventLoop {
     const double vr = pressed ? w_.rest_speed(an, ctx_.dt) : 0.0;
     const bool slow = pressed && m.restitution * std::max(0.0, -vn) < vr;
     const bool own_support = w_.supported(i) && w_.support[i] == k;
-    if (slow && face && !own_support && !w_.stationary(i) && hold(i)) {
+    // A gas's wall impact with nothing else near: the pairwise response, its new path's
+    // broad-phase query asked once, wide enough to prove that the touching set would
+    // hold this face's contact only (isolated_static).
+    bool isolated = false;
+    if (fast_isolated_ && !slow && face && !w_.supported(i) && !w_.stationary(i) && w_.radius[i] > 0.0) {
+      const Vec2 v_before = w_.vel[i];
+      resolve_static(w_, i, n_resp, m, 0.0);
+      if (dot(w_.vel[i], n) < 0.0) resolve_static(w_, i, n, m, 0.0);
+      isolated = isolated_static(i, k, t);
+      if (!isolated) w_.vel[i] = v_before;
+    }
+    if (isolated) {
+      after_velocity_change(i);   // resolved above, as the last branch below does
+    } else if (slow && face && !own_support && !w_.stationary(i) && hold(i)) {
       // Pressed into a second face (a corner, a V) or a face beside bodies at rest:
       // held at rest there if its contacts together can hold it.
     } else if (slow && face && !w_.supported(i) && !w_.any_rules && touches_another_face(i, k) &&
@@ -684,7 +809,7 @@ class EventLoop {
     if (r.event) record_contact(w_, i, kNone, &seg, t_abs, ctx_.dt);
     ++w_.version[i];
     destroy_after(i, r.destroy_first);
-    reschedule(i, t);
+    reschedule(i, t, isolated);
     free_dependents(i, t);
   }
 
@@ -727,6 +852,10 @@ class EventLoop {
   StepContext& ctx_;
   const double T_;
   const bool coupled_;   // Newtonian gravity: events cut the whole system's step
+  // Free flight, no collision rules, the simultaneous law: an impact with nothing else
+  // near is the pairwise law's, proven without the touching set (isolated_pair).
+  const bool fast_isolated_;
+  Aabb found_box_i_, found_box_j_;   // the new paths' boxes isolated_pair/_static found
   std::vector<std::uint32_t> set_;      // the touching set of a simultaneous impact
   std::vector<BodyPair> impacted_;      // its pairs that took an impulse
   std::vector<std::uint32_t> near_;     // bodies near one being held

@@ -165,7 +165,7 @@ static void touching_supports(World& w, std::uint32_t i, std::span<const std::ui
       if (u < 0.0 || u > s.length) continue;
       const double D = dot(p - s.from, s.normal);
       if (std::fabs(std::fabs(D) - r) > tol) continue;
-      out.push_back({i, kBodySupport | k, D >= 0.0 ? s.normal : -s.normal});
+      out.push_back({i, kBodySupport | k, toi::line_side(D, dot(w.vel[i], s.normal), dot(w.acc[i], s.normal)) * s.normal});
       mu.push_back(holding_coefficient(w.pair_material(w.material[i], s.material)));
     }
   }
@@ -797,7 +797,8 @@ void detect_support(World& w, std::uint32_t i, const StepContext& ctx) {
     const double u = dot(p - s.from, s.dir);
     if (u < 0.0 || u > s.length) continue;
     const double D = dot(p - s.from, s.normal);
-    const Vec2 n = D >= 0.0 ? s.normal : -s.normal;
+    // A point exactly on the line is on the side its force presses it from (toi::line_side).
+    const Vec2 n = toi::line_side(D, dot(w.vel[i], s.normal), dot(w.acc[i], s.normal)) * s.normal;
     if (std::fabs(std::fabs(D) - r) > tol) continue;
     const double an = dot(w.acc[i], n);
     if (!(an < 0.0)) continue;

@@ -49,6 +49,7 @@
 #include <cmath>
 #include <limits>
 
+#include "physval/core/time_of_impact.hpp"
 #include "world.hpp"
 
 namespace physval::core_detail {
@@ -223,9 +224,9 @@ double refine_static_impact(const World& w, std::uint32_t i, const Segment& seg,
     const Vec2 q = length_squared(pt - seg.from) <= length_squared(pt - seg.to) ? seg.from : seg.to;
     return root_near([&](double s) { return length(position_on_path(w, i, s) - q) - r; }, t, t_min, T, ftol);
   }
-  // The side the body is on before the impact (a point on the line: the side it moves from).
+  // The side the body is on before the impact (a point on the line: toi::line_side).
   const double D = dot(w.pos[i] - seg.from, seg.normal);
-  const double side = D > 0.0 ? 1.0 : D < 0.0 ? -1.0 : (dot(w.vel[i], seg.normal) < 0.0 ? 1.0 : -1.0);
+  const double side = toi::line_side(D, dot(w.vel[i], seg.normal), dot(w.force_acc(i), seg.normal));
   return root_near([&](double s) { return side * dot(position_on_path(w, i, s) - seg.from, seg.normal) - r; }, t,
                    t_min, T, ftol);
 }
@@ -365,7 +366,7 @@ double refine_coupled_static(World& w, std::uint32_t i, const Segment& seg, bool
     return root_near([&](double s) { return length(at(s) - q) - r; }, t, t_min, T, ftol);
   }
   const double D = dot(w.pos[i] - seg.from, seg.normal);
-  const double side = D > 0.0 ? 1.0 : D < 0.0 ? -1.0 : (dot(w.vel[i], seg.normal) < 0.0 ? 1.0 : -1.0);
+  const double side = toi::line_side(D, dot(w.vel[i], seg.normal), dot(w.force_acc(i), seg.normal));
   return root_near([&](double s) { return side * dot(at(s) - seg.from, seg.normal) - r; }, t, t_min, T, ftol);
 }
 

@@ -172,6 +172,12 @@ double Poly::slope(double s) const {
   return v;
 }
 
+double line_side(double D, double vn, double an) {
+  if (D != 0.0) return D > 0.0 ? 1.0 : -1.0;
+  if (an != 0.0) return an < 0.0 ? 1.0 : -1.0;
+  return vn > 0.0 ? -1.0 : 1.0;
+}
+
 double earliest_entry(const Poly& gap, double T, Tolerance tol) { return entry(gap, T, tol, true); }
 
 Poly circle_circle_gap(Vec2 dp, Vec2 dv, Vec2 da, double R) {
@@ -207,7 +213,7 @@ Tolerance squared_tolerance(double scale, double speed, double R) {
 }
 
 SegmentHit circle_segment(Vec2 p, Vec2 v, Vec2 a, double r, Vec2 from, Vec2 to, double T,
-                          double length_scale) {
+                          double length_scale, Vec2 press) {
   SegmentHit hit;
   const Vec2 e = to - from;
   const double L = length(e);
@@ -218,17 +224,12 @@ SegmentHit circle_segment(Vec2 p, Vec2 v, Vec2 a, double r, Vec2 from, Vec2 to, 
   const Tolerance lin = linear_tolerance(length_scale, speed);
 
   // Faces: the gap to the line on the side the centre is on, and to the far side
-  // (reached only by passing the segment's end first). A point exactly on the line
-  // (placed there: an impact leaves it a hair off) is on the side it moves into, or
-  // at rest, the side its acceleration presses from.
+  // (reached only by passing the segment's end first). A point exactly on the line is
+  // on the side line_side gives: the one its force presses it from. (It was the
+  // side it moves into: a point placed on a floor under gravity was held there at rest
+  // but fell through it moving down, the same spot read as two sides.)
   const double D0 = dot(n, p - from);
-  double side;
-  if (D0 != 0.0) {
-    side = D0 > 0.0 ? 1.0 : -1.0;
-  } else {
-    const double vn = dot(n, v), an = dot(n, a);
-    side = vn > 0.0 ? 1.0 : vn < 0.0 ? -1.0 : (an <= 0.0 ? 1.0 : -1.0);
-  }
+  const double side = line_side(D0, dot(n, v), dot(n, press));
   for (int k = 0; k < 2; ++k) {
     const double sg = k == 0 ? side : -side;
     Poly g;

@@ -150,4 +150,50 @@ TEST(CoreResting, TallStacksHoldExactly) {
   }
 }
 
+// A point placed exactly on a floor (allow_initial_overlap) is on the floor whatever its
+// velocity: the side gravity presses it from (toi::line_side). It used to be held there at
+// rest but fall through moving down (the face tests took the side it moved into), y =
+// -5.9 m after 1 s (validation/tests/hunt/point_on_floor_exact.toml). Every integrator,
+// the floor drawn either way, gravity down (a floor) or up (a ceiling), e 0 to 1: it never
+// crosses the line; at e = 0 moving down it stops on it at once; otherwise its first
+// bounce reaches (e vn)^2 / 2g and a point moving up reaches vn^2 / 2g (Verlet, RK4 exact).
+TEST(CoreResting, APointStartedExactlyOnAFloorNeverCrossesIt) {
+  int cases = 0;
+  for (const char* integ : {"explicit_euler", "semi_implicit_euler", "velocity_verlet", "rk4"}) {
+    for (double dir : {1.0, -1.0}) {
+      for (double up : {1.0, -1.0}) {   // +1: a floor (gravity down), -1: a ceiling
+        for (double e : {0.0, 0.5, 1.0}) {
+          for (Vec2 v : {Vec2{0.0, -1.0}, Vec2{0.7, -1.0}, Vec2{}, Vec2{0.0, 1.0}, Vec2{2.0, -3.0}, Vec2{-1.0, 0.0}}) {
+            const Vec2 v0{v.x, up * v.y};
+            SCOPED_TRACE(std::string(integ) + " dir " + std::to_string(dir) + " up " + std::to_string(up) + " e " +
+                         std::to_string(e) + " v " + std::to_string(v.x) + "," + std::to_string(v.y));
+            Scene sc = scene_of({point("p", {0.0, 0.0}, v0, 1.0, e)},
+                                {wall("floor", {-50.0 * dir, 0.0}, {50.0 * dir, 0.0}, e)}, {0.0, -up * g});
+            Sim sim(sc, options(integ));
+            double apex = 0.0;
+            for (int k = 0; k < 60; ++k) {
+              sim.step(1.0 / 60.0);
+              const double y = up * sim.state("p").position.y;
+              ASSERT_GE(y, -1e-12) << "step " << k;   // never on the other side
+              apex = std::max(apex, y);
+              ASSERT_EQ(sim.engine.broken_guarantee(), "");
+            }
+            ++cases;
+            const bool exact = std::string(integ) == "velocity_verlet" || std::string(integ) == "rk4";
+            if (v.y < 0.0 && e == 0.0) {   // stops on the line at once and slides (frictionless)
+              EXPECT_LE(apex, 1e-12);
+              EXPECT_EQ(sim.state("p").velocity.y, 0.0);
+              EXPECT_NEAR(sim.state("p").position.x, v.x, 1e-12);
+            } else if (exact && v.y != 0.0) {
+              const double vn = v.y < 0.0 ? -e * v.y : v.y;
+              EXPECT_NEAR(apex, vn * vn / (2.0 * g), 1e-3 * vn * vn / (2.0 * g) + 2e-3 * vn) << "sampled per step";
+            }
+          }
+        }
+      }
+    }
+  }
+  EXPECT_EQ(cases, 4 * 2 * 2 * 3 * 6);
+}
+
 }  // namespace physval::test

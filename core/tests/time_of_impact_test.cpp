@@ -84,4 +84,53 @@ TEST(CoreTimeOfImpact, PolynomialEntry) {
   EXPECT_NEAR(earliest_entry(shifted, 10.0, tol), 1.5, 1e-13);
 }
 
+
+// A point exactly on a line (placed there with allow_initial_overlap) is on one side
+// whatever its velocity: the side its acceleration presses it from. Before, it was the
+// side it moved into: a point on a floor under gravity was on the floor at rest and
+// under it moving down (it fell through), one spot read as two sides.
+TEST(CoreTimeOfImpact, APointOnALineIsOnTheSideItsAccelerationPressesFrom) {
+  const double L = 10.0;
+  const Vec2 g{0.0, -9.81};
+  for (double dir : {1.0, -1.0}) {   // the floor drawn left to right (normal up) or right to left (down)
+    const Vec2 from{-5.0 * dir, 0.0}, to{5.0 * dir, 0.0};
+    // Moving down into it: an impact now, against the upper face.
+    SegmentHit h = circle_segment({0.0, 0.0}, {0.3, -1.0}, g, 0.0, from, to, 1.0 / 60.0, L);
+    EXPECT_EQ(h.s, 0.0) << dir;
+    EXPECT_EQ(h.normal.y, 1.0) << dir;
+    // At rest, pressed by gravity: an impact now (it settles), upper face.
+    h = circle_segment({0.0, 0.0}, {}, g, 0.0, from, to, 1.0 / 60.0, L);
+    EXPECT_EQ(h.s, 0.0) << dir;
+    EXPECT_EQ(h.normal.y, 1.0) << dir;
+    // Moving up out of it: no impact (it leaves the floor upwards, and falls back onto it
+    // at 2 v / g, beyond this step).
+    h = circle_segment({0.0, 0.0}, {0.0, 1.0}, g, 0.0, from, to, 1.0 / 60.0, L);
+    EXPECT_EQ(h.s, kNever) << dir;
+    h = circle_segment({0.0, 0.0}, {0.0, 1.0}, g, 0.0, from, to, 1.0, L);
+    EXPECT_NEAR(h.s, 2.0 / 9.81, 1e-15) << dir;
+    EXPECT_EQ(h.normal.y, 1.0) << dir;
+    // A ceiling: gravity up presses it from below.
+    h = circle_segment({0.0, 0.0}, {0.0, 1.0}, -g, 0.0, from, to, 1.0 / 60.0, L);
+    EXPECT_EQ(h.s, 0.0) << dir;
+    EXPECT_EQ(h.normal.y, -1.0) << dir;
+  }
+  // The rule itself: off the line, the sign of D; on it, against the acceleration; without
+  // one, the side it moves from; with neither, +1.
+  EXPECT_EQ(line_side(1e-300, -1.0, 1.0), 1.0);
+  EXPECT_EQ(line_side(-1e-300, 1.0, -1.0), -1.0);
+  EXPECT_EQ(line_side(0.0, 1.0, -9.8), 1.0);
+  EXPECT_EQ(line_side(0.0, -1.0, 9.8), -1.0);
+  EXPECT_EQ(line_side(0.0, -1.0, 0.0), 1.0);
+  EXPECT_EQ(line_side(0.0, 1.0, 0.0), -1.0);
+  EXPECT_EQ(line_side(0.0, 0.0, 0.0), 1.0);
+  // Explicit Euler's path has no acceleration within the step; the force still decides
+  // the side (`press`): a point on a floor moving up leaves it, moving down meets it.
+  EXPECT_EQ(circle_segment({0.0, 0.0}, {0.0, 1.0}, {}, 0.0, {-5.0, 0.0}, {5.0, 0.0}, 0.1, L, g).s, kNever);
+  EXPECT_EQ(circle_segment({0.0, 0.0}, {0.0, -1.0}, {}, 0.0, {-5.0, 0.0}, {5.0, 0.0}, 0.1, L, g).normal.y, 1.0);
+  // No acceleration, moving into the line: met now, from the side it comes from.
+  const SegmentHit h = circle_segment({0.0, 0.0}, {0.0, -2.0}, {}, 0.0, {-5.0, 0.0}, {5.0, 0.0}, 0.1, L);
+  EXPECT_EQ(h.s, 0.0);
+  EXPECT_EQ(h.normal.y, 1.0);
+}
+
 }  // namespace physval::toi

@@ -2,9 +2,11 @@
 // with `range(0)` contact events per run, bodies and samples of a 1k-body scene).
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <random>
 
 #include "physval/validation/comparator.hpp"
+#include "../src/containment.hpp"
 
 namespace physval {
 namespace {
@@ -53,6 +55,86 @@ void BM_ComparePairContactHeavy(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(contacts));
 }
 BENCHMARK(BM_ComparePairContactHeavy)->Arg(1000)->Arg(10000)->Arg(40000)->Unit(benchmark::kMillisecond);
+
+// What run_suite does for one contact-heavy scene of five engines: each run against the
+// reference, then the ten pairs, through one ScenarioComparer (the contacts' pair ids and
+// the scales computed once per run).
+void BM_ScenarioComparisonsContactHeavy(benchmark::State& state) {
+  const auto contacts = static_cast<std::size_t>(state.range(0));
+  const std::size_t bodies = 1000, samples = 100;
+  Scene scene;
+  scene.name = "gas";
+  scene.dt = 1.0 / 240.0;
+  scene.duration = 4.0;
+  Reference reference;
+  reference.available = reference.converged = true;
+  reference.dt = scene.dt / 8.0;
+  reference.run = gas_run("reference", bodies, contacts, samples, 1);
+  std::vector<RunRecord> runs;
+  for (unsigned e = 0; e < 5; ++e) runs.push_back(gas_run("engine" + std::to_string(e), bodies, contacts, samples, 1 + e % 2));
+  for (auto _ : state) {
+    ScenarioComparer comparer(scene, reference);
+    for (RunRecord& r : runs) comparer.compare_run(r, false);
+    std::vector<PairComparison> pairs;
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      for (std::size_t j = i + 1; j < runs.size(); ++j) pairs.push_back(comparer.compare_pair(runs[i], runs[j]));
+    }
+    benchmark::DoNotOptimize(pairs);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(15 * contacts));
+}
+BENCHMARK(BM_ScenarioComparisonsContactHeavy)->Arg(10000)->Arg(30000)->Unit(benchmark::kMillisecond);
+
+// Containment after one step of a gas (runner.cpp calls it after every step of every
+// run): `range(0)` circles (r = 0.05 m) 0.22 m apart in a walled box, as
+// scripts/make_gas.py makes them, moving straight and bouncing off the walls.
+void BM_ContainmentObserveGas(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  const std::size_t side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(n))));
+  const double spacing = 0.22, half = static_cast<double>(side) * spacing / 2.0 + 0.1;
+  Scene scene;
+  scene.name = "gas";
+  const Vec2 c[4] = {{-half, -half}, {half, -half}, {half, half}, {-half, half}};
+  for (int k = 0; k < 4; ++k) {
+    WallDef w;
+    w.name = "w" + std::to_string(k);
+    w.from = c[k];
+    w.to = c[(k + 1) % 4];
+    scene.walls.push_back(w);
+  }
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::vector<BodyState> states(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    BodyDef b;
+    b.name = "c" + std::to_string(i);
+    b.radius = 0.05;
+    b.position = {static_cast<double>(i % side) * spacing - half + 0.1 + spacing / 2.0,
+                  static_cast<double>(i / side) * spacing - half + 0.1 + spacing / 2.0};
+    scene.bodies.push_back(b);
+    states[i].position = b.position;
+    states[i].velocity = {unit(rng), unit(rng)};
+  }
+  ContainmentMonitor monitor(scene);
+  monitor.start(states);
+  const double h = 1.0 / 60.0;
+  double t = 0.0;
+  for (auto _ : state) {
+    t += h;
+    for (BodyState& s : states) {
+      s.position = s.position + s.velocity * h;
+      for (double* x : {&s.position.x, &s.position.y}) {
+        if (std::abs(*x) > half - 0.05) *x = std::copysign(half - 0.05, *x);
+      }
+      if (std::abs(s.position.x) >= half - 0.05) s.velocity.x = -s.velocity.x;
+      if (std::abs(s.position.y) >= half - 0.05) s.velocity.y = -s.velocity.y;
+    }
+    monitor.observe(t, states);
+    benchmark::DoNotOptimize(monitor.record());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n));
+}
+BENCHMARK(BM_ContainmentObserveGas)->Arg(200)->Arg(1000)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace physval

@@ -114,65 +114,80 @@ struct ContactMatch {
   std::vector<std::optional<double>> per_reference;   // error of each reference contact (nullopt: missed)
 };
 
+// Object pairs as dense ids, names hashed once per contact list: a gas has thousands of
+// contacts and each run's are matched against five or six others.
+struct PairTable {
+  std::unordered_map<std::string_view, std::uint32_t> names;
+  std::unordered_map<std::uint64_t, std::uint32_t> pairs;
+  PairTable() {
+    names.reserve(64);
+    pairs.reserve(1024);
+  }
+  // The id of each contact's unordered pair of names.
+  std::vector<std::uint32_t> ids(const std::vector<ContactRecord>& contacts) {
+    auto name = [&](const std::string& n) {
+      return names.emplace(std::string_view(n), static_cast<std::uint32_t>(names.size())).first->second;
+    };
+    std::vector<std::uint32_t> out(contacts.size());
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+      const std::uint32_t x = name(contacts[k].a), y = name(contacts[k].b);
+      const std::uint64_t key = (static_cast<std::uint64_t>(std::min(x, y)) << 32) | std::max(x, y);
+      out[k] = pairs.emplace(key, static_cast<std::uint32_t>(pairs.size())).first->second;
+    }
+    return out;
+  }
+};
+
 // Matches contact-begin events pair by pair: each reference contact takes the
 // earliest unmatched run contact of the same pair within `window` seconds (earliest in
 // the run's order; the scan of a pair stops at the first of its contacts later than
-// the window). The run's contacts are grouped by pair once, and each pair keeps a
-// cursor past the contacts no later reference contact of that pair can take (used, or
-// earlier than the smallest remaining reference time minus the window), so the cost is
-// about linear in the number of contacts instead of run x reference.
-ContactMatch match_contacts(const std::vector<ContactRecord>& run, const std::vector<ContactRecord>& ref,
-                            double window) {
+// the window). The run's contacts are grouped by pair once (`run_ids`, `ref_ids`: the
+// pair of each contact, ids below `pair_count`), and each pair keeps a cursor past the
+// contacts no later reference contact of that pair can take (used, or earlier than the
+// smallest remaining reference time minus the window), so the cost is about linear in
+// the number of contacts instead of run x reference.
+ContactMatch match_contacts(const std::vector<ContactRecord>& run, const std::vector<std::uint32_t>& run_ids,
+                            const std::vector<ContactRecord>& ref, const std::vector<std::uint32_t>& ref_ids,
+                            std::size_t pair_count, double window) {
   ContactMatch m;
   m.per_reference.resize(ref.size());
-  struct PairQueue {
-    std::vector<std::size_t> run;        // indices into `run`, in the run's order
-    std::size_t cursor = 0;              // run[0..cursor) are dead for this pair
-    std::vector<std::size_t> ref;        // indices into `ref`, in the reference's order
-    std::vector<double> ref_min_after;   // min time of ref[k..] (suffix minimum)
-    std::size_t ref_seen = 0;
-  };
-  // Pairs by the ids of their names (the unordered pair: smaller id first), no strings
-  // copied: a gas has thousands of contacts.
-  std::unordered_map<std::string_view, std::uint32_t> ids;
-  auto id = [&](const std::string& name) {
-    return ids.emplace(std::string_view(name), static_cast<std::uint32_t>(ids.size())).first->second;
-  };
-  std::unordered_map<std::uint64_t, std::size_t> pair_index;
-  std::vector<PairQueue> pairs;
-  auto queue = [&](const ContactRecord& c) -> std::size_t {
-    const std::uint32_t x = id(c.a), y = id(c.b);
-    const std::uint64_t key = (static_cast<std::uint64_t>(std::min(x, y)) << 32) | std::max(x, y);
-    const auto [it, added] = pair_index.emplace(key, pairs.size());
-    if (added) pairs.emplace_back();
-    return it->second;
-  };
-  ids.reserve(64);
-  pair_index.reserve(run.size() + ref.size());
-  for (std::size_t j = 0; j < run.size(); ++j) pairs[queue(run[j])].run.push_back(j);
-  std::vector<std::size_t> ref_queue(ref.size());
-  for (std::size_t i = 0; i < ref.size(); ++i) {
-    ref_queue[i] = queue(ref[i]);
-    pairs[ref_queue[i]].ref.push_back(i);
+  // Each pair's run contacts and reference contacts, in their lists' order, as slices of
+  // two index arrays (a counting sort by pair).
+  std::vector<std::uint32_t> run_start(pair_count + 1, 0), ref_start(pair_count + 1, 0);
+  for (const std::uint32_t p : run_ids) ++run_start[p + 1];
+  for (const std::uint32_t p : ref_ids) ++ref_start[p + 1];
+  for (std::size_t p = 0; p < pair_count; ++p) {
+    run_start[p + 1] += run_start[p];
+    ref_start[p + 1] += ref_start[p];
   }
-  for (PairQueue& q : pairs) {
-    q.ref_min_after.resize(q.ref.size());
+  std::vector<std::uint32_t> run_of(run.size()), ref_of(ref.size());
+  {
+    std::vector<std::uint32_t> fill(run_start.begin(), run_start.end() - 1);
+    for (std::size_t j = 0; j < run.size(); ++j) run_of[fill[run_ids[j]]++] = static_cast<std::uint32_t>(j);
+    fill.assign(ref_start.begin(), ref_start.end() - 1);
+    for (std::size_t i = 0; i < ref.size(); ++i) ref_of[fill[ref_ids[i]]++] = static_cast<std::uint32_t>(i);
+  }
+  // min time of the pair's reference contacts from the k-th on (suffix minimum)
+  std::vector<double> ref_min_after(ref.size());
+  for (std::size_t p = 0; p < pair_count; ++p) {
     double least = std::numeric_limits<double>::infinity();
-    for (std::size_t k = q.ref.size(); k-- > 0;) {
-      least = std::min(least, ref[q.ref[k]].time);
-      q.ref_min_after[k] = least;
+    for (std::size_t k = ref_start[p + 1]; k-- > ref_start[p];) {
+      least = std::min(least, ref[ref_of[k]].time);
+      ref_min_after[k] = least;
     }
   }
-  std::vector<bool> used(run.size(), false);
+  std::vector<std::uint32_t> cursor(run_start.begin(), run_start.end() - 1);   // run_of[start..cursor) are dead
+  std::vector<std::uint32_t> ref_seen(ref_start.begin(), ref_start.end() - 1);
+  std::vector<char> used(run.size(), 0);
   for (std::size_t i = 0; i < ref.size(); ++i) {
-    PairQueue& q = pairs[ref_queue[i]];
-    const double earliest_wanted = q.ref_min_after[q.ref_seen++] - window;
-    while (q.cursor < q.run.size() && (used[q.run[q.cursor]] || run[q.run[q.cursor]].time < earliest_wanted)) {
-      ++q.cursor;
-    }
+    const std::uint32_t p = ref_ids[i];
+    const std::uint32_t end = run_start[p + 1];
+    const double earliest_wanted = ref_min_after[ref_seen[p]++] - window;
+    std::uint32_t& c = cursor[p];
+    while (c < end && (used[run_of[c]] || run[run_of[c]].time < earliest_wanted)) ++c;
     std::optional<std::size_t> best;
-    for (std::size_t k = q.cursor; k < q.run.size(); ++k) {
-      const std::size_t j = q.run[k];
+    for (std::uint32_t k = c; k < end; ++k) {
+      const std::size_t j = run_of[k];
       if (used[j]) continue;
       if (std::abs(run[j].time - ref[i].time) <= window) {
         best = j;
@@ -181,7 +196,7 @@ ContactMatch match_contacts(const std::vector<ContactRecord>& run, const std::ve
       if (run[j].time > ref[i].time + window) break;
     }
     if (best) {
-      used[*best] = true;
+      used[*best] = 1;
       const double e = std::abs(run[*best].time - ref[i].time);
       m.per_reference[i] = e;
       m.max_error = std::max(m.max_error.value_or(0.0), e);
@@ -190,8 +205,15 @@ ContactMatch match_contacts(const std::vector<ContactRecord>& run, const std::ve
       ++m.missed;
     }
   }
-  m.extra = static_cast<int>(std::count(used.begin(), used.end(), false));
+  m.extra = static_cast<int>(std::count(used.begin(), used.end(), 0));
   return m;
+}
+
+ContactMatch match_contacts(const std::vector<ContactRecord>& run, const std::vector<ContactRecord>& ref,
+                            double window) {
+  PairTable table;
+  const std::vector<std::uint32_t> run_ids = table.ids(run), ref_ids = table.ids(ref);
+  return match_contacts(run, run_ids, ref, ref_ids, table.pairs.size(), window);
 }
 
 double contact_window(double dt) { return std::max(5.0 * dt, 0.05); }
@@ -422,7 +444,45 @@ Reference make_reference(const Scene& scene, const RunOptions& options) {
   return ref;
 }
 
+struct ScenarioComparer::Cache {
+  PairTable table;
+  std::unordered_map<const std::vector<ContactRecord>*, std::vector<std::uint32_t>> ids;
+  std::unordered_map<const Series*, Scales> scales;
+  // A list's pair ids, computed on its first comparison.
+  const std::vector<std::uint32_t>& ids_of(const std::vector<ContactRecord>& contacts) {
+    auto it = ids.find(&contacts);
+    if (it == ids.end()) it = ids.emplace(&contacts, table.ids(contacts)).first;
+    return it->second;
+  }
+  const Scales& scales_of(const Scene& scene, const Series* motion) {
+    auto it = scales.find(motion);
+    if (it == scales.end()) it = scales.emplace(motion, characteristic_scales(scene, motion)).first;
+    return it->second;
+  }
+  ContactMatch match(const std::vector<ContactRecord>& run, const std::vector<ContactRecord>& ref, double window) {
+    const std::vector<std::uint32_t>& run_ids = ids_of(run);
+    const std::vector<std::uint32_t>& ref_ids = ids_of(ref);
+    return match_contacts(run, run_ids, ref, ref_ids, table.pairs.size(), window);
+  }
+};
+
+ScenarioComparer::ScenarioComparer(const Scene& scene, const Reference& reference)
+    : scene_(scene), reference_(reference), cache_(std::make_unique<Cache>()) {}
+
+ScenarioComparer::~ScenarioComparer() = default;
+
 void compare_run(RunRecord& run, const Scene& scene, const Reference& reference, bool enforce_gates) {
+  ScenarioComparer(scene, reference).compare_run(run, enforce_gates);
+}
+
+PairComparison compare_pair(const RunRecord& a, const RunRecord& b, const Scene& scene) {
+  static const Reference none;
+  return ScenarioComparer(scene, none).compare_pair(a, b);
+}
+
+void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
+  const Scene& scene = scene_;
+  const Reference& reference = reference_;
   run.metrics.clear();
   run.checks.clear();
   for (std::string_view name : kMetricNames) run.metrics[std::string(name)] = std::nullopt;
@@ -430,7 +490,7 @@ void compare_run(RunRecord& run, const Scene& scene, const Reference& reference,
   run.metrics["wall_seconds"] = run.wall_seconds;
 
   const Conserved conserved = conserved_quantities(scene);
-  const Scales scales = characteristic_scales(scene, reference.run ? &reference.run->series : nullptr);
+  const Scales& scales = cache_->scales_of(scene, reference.run ? &reference.run->series : nullptr);
   const Series& s = run.series;
   bool energy_diverged = false;   // the run's status came from its energy (below)
   if (!s.totals.empty()) {
@@ -489,16 +549,17 @@ void compare_run(RunRecord& run, const Scene& scene, const Reference& reference,
   }
 
   // Contact timing: against [expect] contacts when given, else the reference's.
-  std::optional<std::vector<ContactRecord>> ref_contacts;
+  std::optional<ContactMatch> contact_match;
   if (!scene.expect.contacts.empty()) {
-    ref_contacts.emplace();
-    for (const ExpectedContact& c : scene.expect.contacts) ref_contacts->push_back({c.a, c.b, c.time, 0});
+    std::vector<ContactRecord> expected;
+    for (const ExpectedContact& c : scene.expect.contacts) expected.push_back({c.a, c.b, c.time, 0});
+    contact_match = match_contacts(run.contacts, expected, contact_window(run.dt));
   } else if (reference.available && reference.converged && reference.run) {
-    ref_contacts = reference.run->contacts;
+    contact_match = cache_->match(run.contacts, reference.run->contacts, contact_window(run.dt));
   }
   if (!run.contacts.empty()) run.metrics["first_contact_time"] = run.contacts.front().time;
-  if (ref_contacts) {
-    const ContactMatch m = match_contacts(run.contacts, *ref_contacts, contact_window(run.dt));
+  if (contact_match) {
+    const ContactMatch& m = *contact_match;
     run.metrics["contact_time_error"] = m.max_error;
     if (m.max_error) run.metrics["contact_time_error_steps"] = *m.max_error / run.dt;
     run.metrics["missed_contacts"] = m.missed;
@@ -610,17 +671,18 @@ void compare_run(RunRecord& run, const Scene& scene, const Reference& reference,
   }
 }
 
-PairComparison compare_pair(const RunRecord& a, const RunRecord& b, const Scene& scene) {
+PairComparison ScenarioComparer::compare_pair(const RunRecord& a, const RunRecord& b) {
+  const Scene& scene = scene_;
   PairComparison pc;
   pc.scenario = scene.name;
   pc.a = a.engine;
   pc.b = b.engine;
-  const Scales scales = characteristic_scales(scene, &a.series);
+  const Scales& scales = cache_->scales_of(scene, &a.series);
   const SeriesDivergence d = series_divergence(b.series, a.series, same_time(a.dt, b.dt), scales, 1e300, scene.bodies.size());
   pc.metrics["position_divergence"] = d.position_max;
   pc.metrics["energy_divergence"] = d.energy_max;
   pc.metrics["linear_momentum_divergence"] = d.momentum_max;
-  const ContactMatch m = match_contacts(b.contacts, a.contacts, contact_window(std::max(a.dt, b.dt)));
+  const ContactMatch m = cache_->match(b.contacts, a.contacts, contact_window(std::max(a.dt, b.dt)));
   pc.metrics["contact_time_error"] = m.max_error;
   pc.metrics["missed_contacts"] = m.missed;
   pc.metrics["extra_contacts"] = m.extra;

@@ -238,29 +238,33 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
   // Moving pairs: a sweep over x of each body's box swept over the step (a pair that
   // passed right through each other within one step overlaps there, not at its ends), the
   // order kept from the step before (insertion sort is linear on an almost sorted list).
-  for (std::size_t p = 1; p < order_.size(); ++p) {
+  // The sort compares the left ends laid out in the order's order (sorted_lo_, gathered
+  // first), moving them with the order: the same comparisons on the same values as
+  // reading lo_ through the order, without the indirection.
+  const std::size_t n = order_.size();
+  sorted_lo_.resize(n);
+  for (std::size_t p = 0; p < n; ++p) sorted_lo_[p] = lo_[order_[p]];
+  for (std::size_t p = 1; p < n; ++p) {
     const std::size_t v = order_[p];
-    const double key = lo_[v];
+    const double key = sorted_lo_[p];
     std::size_t q = p;
-    while (q > 0 && lo_[order_[q - 1]] > key) {
+    while (q > 0 && sorted_lo_[q - 1] > key) {
       order_[q] = order_[q - 1];
+      sorted_lo_[q] = sorted_lo_[q - 1];
       --q;
     }
     order_[q] = v;
+    sorted_lo_[q] = key;
   }
   // The sweep reads the bodies in x order from arrays laid out in that order: left ends,
   // and the y interval the centre swept (NaN for a body that is not alive).
-  const std::size_t n = order_.size();
-  sorted_lo_.resize(n);
-  sorted_ylo_.resize(n);
-  sorted_yhi_.resize(n);
+  sorted_y_.resize(n);
+  if (near_.size() < n) near_.resize(n);
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t p = 0; p < n; ++p) {
     const std::size_t i = order_[p];
-    sorted_lo_[p] = lo_[i];
     const double y0 = before(i).y, y1 = pos_[i].y;
-    sorted_ylo_[p] = alive_[i] ? std::min(y0, y1) : kNaN;
-    sorted_yhi_[p] = alive_[i] ? std::max(y0, y1) : kNaN;
+    sorted_y_[p] = alive_[i] ? YRange{std::min(y0, y1), std::max(y0, y1)} : YRange{kNaN, kNaN};
   }
   for (std::size_t p = 0; p < n; ++p) {
     const std::size_t i = order_[p];
@@ -268,19 +272,29 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
     const Vec2 xi = pos_[i];
     const double ri = radius_[i];
     const double hi = std::max(xi.x, before(i).x) + ri;
-    const double ylo = sorted_ylo_[p], yhi = sorted_yhi_[p];
+    const double ylo = sorted_y_[p].lo, yhi = sorted_y_[p].hi;
     const std::size_t gi = body_group_[i] * n_body_groups_;
+    // The bodies after i in x order whose box starts before i's ends, filtered by the swept
+    // y intervals: farther apart than the radii together could be (max_radius_ bounds rj)
+    // or j not alive (NaN) is skipped without touching anything else of j. The filter is
+    // branch-free (each index is written, the count advanced by the test), since in a gas
+    // it fails unpredictably for most of the x neighbours; the survivors are then taken
+    // in the same order as before.
+    const double reach = (ri + max_radius_) * (1.0 + 1e-9);
+    const double y_lo = ylo - reach, y_hi = yhi + reach;
+    std::size_t found = 0;
     for (std::size_t q = p + 1; q < n && sorted_lo_[q] <= hi; ++q) {
-      // The swept y intervals farther apart than the radii together could be (max_radius_
-      // bounds rj) or j not alive (NaN): skipped without touching anything else of j.
-      const double reach = (ri + max_radius_) * (1.0 + 1e-9);
-      if (!(sorted_ylo_[q] <= yhi + reach && sorted_yhi_[q] >= ylo - reach)) continue;
+      near_[found] = static_cast<std::uint32_t>(q);
+      found += static_cast<std::size_t>((sorted_y_[q].lo <= y_hi) & (sorted_y_[q].hi >= y_lo));
+    }
+    for (std::size_t f = 0; f < found; ++f) {
+      const std::size_t q = near_[f];
       const std::size_t j = order_[q];
       const double rj = radius_[j];
       // The same with j's own radius (a margin far above rounding): the centres stayed
       // farther apart in y than the radii together all step long, so nothing below happens.
       const double reach_j = (ri + rj) * (1.0 + 1e-9);
-      if (sorted_ylo_[q] > yhi + reach_j || sorted_yhi_[q] < ylo - reach_j) continue;
+      if (sorted_y_[q].lo > yhi + reach_j || sorted_y_[q].hi < ylo - reach_j) continue;
       if (!pair_collides_[gi + body_group_[j]]) continue;
       const Vec2 xj = pos_[j];
       const double depth = ri + rj - length(xi - xj);

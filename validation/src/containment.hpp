@@ -67,7 +67,12 @@ class ContainmentMonitor {
   std::vector<Vec2> pos_;
   std::vector<char> alive_;
   // lo_ and the y interval swept over the step (NaN: not alive), in order_'s order
-  std::vector<double> sorted_lo_, sorted_ylo_, sorted_yhi_;
+  std::vector<double> sorted_lo_;
+  struct YRange {
+    double lo, hi;
+  };
+  std::vector<YRange> sorted_y_;
+  std::vector<std::uint32_t> near_;           // observe's scratch: one body's candidates
   double max_radius_ = 0.0;                    // of the moving bodies
   std::vector<std::uint32_t> on_line_count_;   // on_line_ entries of the body
   // Each barrier's bounding box, widened by 2 eps: a body's path whose box misses it

@@ -3,6 +3,7 @@
 #include <poll.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -39,11 +40,6 @@ class Writer {
   }
   void state(const BodyState& s) {
     const double d[6] = {s.position.x, s.position.y, s.velocity.x, s.velocity.y, s.angle, s.angular_velocity};
-    raw(d, sizeof d);
-    b(s.alive);
-  }
-  void sample(const SampleState& s) {
-    const double d[2] = {s.position.x, s.position.y};
     raw(d, sizeof d);
     b(s.alive);
   }
@@ -111,7 +107,20 @@ void write_record(Sink& sink, const RunRecord& r) {
     static const SampleRow none;
     const SampleRow& st = k < r.series.states.size() ? r.series.states[k] : none;
     w.u64(st.size());
-    for (const SampleState& s : st) w.sample(s);
+    // The row's samples encoded in blocks (one put per block, not three per body).
+    constexpr std::size_t kBlock = 256, kSampleBytes = 2 * sizeof(double) + 1;
+    std::uint8_t block[kBlock * kSampleBytes];
+    for (std::size_t i = 0; i < st.size(); i += kBlock) {
+      const std::size_t n = std::min(kBlock, st.size() - i);
+      std::uint8_t* o = block;
+      for (std::size_t m = 0; m < n; ++m, o += kSampleBytes) {
+        const SampleState& s = st[i + m];
+        std::memcpy(o, &s.position.x, sizeof(double));
+        std::memcpy(o + sizeof(double), &s.position.y, sizeof(double));
+        o[2 * sizeof(double)] = s.alive ? 1 : 0;
+      }
+      w.raw(block, n * kSampleBytes);
+    }
   }
   w.u64(r.final_states.size());
   for (const BodyState& s : r.final_states) w.state(s);
@@ -140,7 +149,7 @@ struct FdSink {
   bool ok = true;
   std::vector<std::uint8_t> buffer;
   std::size_t used = 0;
-  explicit FdSink(int f) : fd(f), buffer(1 << 16) {}
+  explicit FdSink(int f) : fd(f), buffer(1 << 18) {}
   void flush() {
     std::size_t done = 0;
     while (ok && done < used) {
@@ -182,7 +191,7 @@ struct VectorSource {
 struct FdSource {
   int fd;
   std::optional<std::chrono::steady_clock::time_point> deadline;
-  std::vector<std::uint8_t> buffer = std::vector<std::uint8_t>(1 << 16);
+  std::vector<std::uint8_t> buffer = std::vector<std::uint8_t>(1 << 18);
   std::size_t begin = 0, end = 0, total = 0;
   void fill() {
     for (;;) {
@@ -275,14 +284,7 @@ class Reader {
     s.alive = b();
     return s;
   }
-  SampleState sample() {
-    double d[2];
-    src_.get(d, sizeof d);
-    SampleState s;
-    s.position = {d[0], d[1]};
-    s.alive = b();
-    return s;
-  }
+  void raw(void* p, std::size_t n) { src_.get(p, n); }
 
  private:
   Source& src_;
@@ -365,7 +367,22 @@ RunRecord read_record(Source& source) {
     const std::uint64_t n = rd.count();
     SampleRow st;
     reserve_some(st, n);
-    for (std::uint64_t i = 0; i < n; ++i) st.push_back(rd.sample());
+    // Read in blocks, as written (a corrupt count fails on reading, not allocating).
+    constexpr std::size_t kBlock = 256, kSampleBytes = 2 * sizeof(double) + 1;
+    std::uint8_t block[kBlock * kSampleBytes];
+    for (std::uint64_t i = 0; i < n; i += kBlock) {
+      const auto m = static_cast<std::size_t>(std::min<std::uint64_t>(kBlock, n - i));
+      rd.raw(block, m * kSampleBytes);
+      for (std::size_t q = 0; q < m; ++q) {
+        const std::uint8_t* c = block + q * kSampleBytes;
+        SampleState x;
+        std::memcpy(&x.position.x, c, sizeof(double));
+        std::memcpy(&x.position.y, c + sizeof(double), sizeof(double));
+        if (c[2 * sizeof(double)] > 1) throw std::runtime_error("run record: malformed (flag)");
+        x.alive = c[2 * sizeof(double)] == 1;
+        st.push_back(x);
+      }
+    }
     r.series.states.push_back(std::move(st));
   }
   const std::uint64_t nf = rd.count();

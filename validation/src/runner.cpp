@@ -2,6 +2,7 @@
 // variant forks, so an engine that crashes, aborts or hangs costs only its own run.
 #include "physval/validation/runner.hpp"
 
+#include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
@@ -371,6 +372,9 @@ RunRecord run_isolated(const Scene& scene, const EngineFactory& factory, const R
   if (!options.isolate) return run_engine(scene, factory, options);
   int fds[2];
   if (::pipe(fds) != 0) return run_engine(scene, factory, options);
+  // A larger pipe (1 MB where the system allows it; else the default 64 kB stays): the
+  // record of a large run crosses in a few turns of child and parent, not hundreds.
+  (void)::fcntl(fds[1], F_SETPIPE_SZ, 1 << 20);
   std::fflush(stdout);
   std::fflush(stderr);
   install_child_forwarding_handlers();

@@ -126,11 +126,12 @@ SuiteResult run_suite(std::vector<Scene> scenes, const std::vector<std::string>&
   run_tasks(compare_costs, jobs, [&](std::size_t s) {
     ScenarioResult& sr = result.scenarios[s];
     const double cpu0 = thread_cpu_seconds();
-    for (RunRecord& run : sr.runs) compare_run(run, sr.scene, sr.reference, enforce_gates);
+    ScenarioComparer comparer(sr.scene, sr.reference);   // what the comparisons share, computed once
+    for (RunRecord& run : sr.runs) comparer.compare_run(run, enforce_gates);
     for (std::size_t i = 0; i < sr.runs.size(); ++i) {
       for (std::size_t j = i + 1; j < sr.runs.size(); ++j) {
         if (sr.runs[i].status != RunStatus::Ok || sr.runs[j].status != RunStatus::Ok) continue;
-        sr.pairs.push_back(compare_pair(sr.runs[i], sr.runs[j], sr.scene));
+        sr.pairs.push_back(comparer.compare_pair(sr.runs[i], sr.runs[j]));
       }
     }
     sr.compare_cpu_seconds = thread_cpu_seconds() - cpu0;

@@ -40,14 +40,30 @@ double circle_circle(Vec2 dp, Vec2 dv, Vec2 da, double R, double T, Tolerance to
 Poly circle_circle_gap(Vec2 dp, Vec2 dv, Vec2 da, double R);
 
 // A circle of radius r (0 for a point) on the path p + v s + 1/2 a s^2 against the
-// segment [from, to], which it meets on either face or at an end cap.
+// segment [from, to], which it meets on either face or at an end cap. `press`: the
+// acceleration of the forces on the body, which decides the side of a point exactly on
+// the line (line_side); it differs from a when the integrator's path ignores the force
+// within the step (explicit Euler) or a support constrains the path.
 struct SegmentHit {
   double s = kNever;   // time of impact, kNever if none within [0, T]
   Vec2 normal;         // unit, from the segment towards the circle's centre at impact
   bool cap = false;    // hit an end point rather than a face
 };
 SegmentHit circle_segment(Vec2 p, Vec2 v, Vec2 a, double r, Vec2 from, Vec2 to, double T,
-                          double length_scale);
+                          double length_scale, Vec2 press);
+inline SegmentHit circle_segment(Vec2 p, Vec2 v, Vec2 a, double r, Vec2 from, Vec2 to, double T,
+                                 double length_scale) {
+  return circle_segment(p, v, a, r, from, to, T, length_scale, a);
+}
+
+// The side (+1 or -1 along the line's normal n) of a body whose centre is at signed
+// distance D from the line, with normal velocity vn = v.n and acceleration an = a.n. Off
+// the line, the sign of D. Exactly on it (a point placed there: an impact leaves a point a
+// hair off its face), the side its acceleration presses it from (a point on a floor under
+// gravity is above it, at rest, moving down or moving up: one spot, one side); with no
+// normal acceleration, the side it moves from (a zero-thickness barrier is met, never
+// crossed); with neither, +1. Every test of which face a body meets uses this rule.
+double line_side(double D, double vn, double an);
 
 // Tolerances for a contact between objects at coordinates of magnitude `scale` (m)
 // moving at `speed` (m/s): a few ulps of round-off, in gap units (m for a face gap,

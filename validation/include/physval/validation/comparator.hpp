@@ -2,6 +2,8 @@
 // from the reference, contact timing, expectations, gates.
 #pragma once
 
+#include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -43,5 +45,25 @@ struct PairComparison {
                      // contact_time_error, missed_contacts (in b, of a's), extra_contacts
 };
 PairComparison compare_pair(const RunRecord& a, const RunRecord& b, const Scene& scene);
+
+// compare_run and compare_pair for all the runs of one scene, with the same results, but
+// what several comparisons share is computed once: each run's contacts as ids of one
+// table of object pairs (names hashed once per run, not once per comparison) and each
+// series' characteristic scales. The scene, the reference and the runs must outlive it
+// and their contacts and series must not change meanwhile (run_suite's comparisons).
+class ScenarioComparer {
+ public:
+  ScenarioComparer(const Scene& scene, const Reference& reference);
+  ~ScenarioComparer();
+  void compare_run(RunRecord& run, bool enforce_gates);
+  PairComparison compare_pair(const RunRecord& a, const RunRecord& b);
+
+  struct Cache;
+
+ private:
+  const Scene& scene_;
+  const Reference& reference_;
+  std::unique_ptr<Cache> cache_;
+};
 
 }  // namespace physval

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <ostream>
 #include <string>
+#include <string_view>
 
 #include <nlohmann/json.hpp>
 
@@ -27,7 +28,7 @@ void write_results_json(const std::filesystem::path& path, const SuiteResult& re
 
 // Writes text to path whole or not at all (temporary file in the same folder, then
 // rename). Creates the folder. Throws std::runtime_error on failure.
-void write_file_atomically(const std::filesystem::path& path, const std::string& text);
+void write_file_atomically(const std::filesystem::path& path, std::string_view text);
 
 // An output folder that appears whole or not at all. The constructor checks the final
 // folder before anything runs (not a file; an existing folder is replaced only when it
