@@ -10,14 +10,12 @@
 #include "physval/validation/comparator.hpp"
 #include "physval/validation/scenario_loader.hpp"
 
+#include "builtin_scene.hpp"
+
 namespace physval {
 namespace {
 
-Scene load_builtin(const std::string& relative) {
-  ScenarioLoad load = load_scenario_file(std::string(PHYSVAL_SCENARIO_DIR) + "/" + relative);
-  if (!load.scene) throw std::runtime_error("cannot load " + relative);
-  return *load.scene;
-}
+using test::load_builtin;
 
 TEST(DragReference, BuiltinDragBallSceneHasAConvergedReference) {
   const Scene scene = load_builtin("models/drag_ball_wall_floor.toml");
