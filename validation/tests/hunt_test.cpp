@@ -261,7 +261,7 @@ TEST(Hunt, CoreMeetsThePointOnFloorClosedForm) { expect_core_meets("point_on_flo
 // friction to stay, the lower with enough for itself but not for both: they must slide
 // together at 0.1287 m/s^2; core holds both at rest for ever, `ok` (a held body leans on a
 // stuck one as on a fixed support, and the stuck one is never judged with that load).
-TEST(Hunt, DISABLED_CoreMeetsTheSlopePairClosedForm) { expect_core_meets("slope_pair_push.toml"); }
+TEST(Hunt, CoreMeetsTheSlopePairClosedForm) { expect_core_meets("slope_pair_push.toml"); }
 
 }  // namespace
 }  // namespace physval
