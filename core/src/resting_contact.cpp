@@ -311,8 +311,10 @@ namespace {
 // leans on are judged with its load: a body at rest on a face by its own friction, or
 // held, only looks fixed; the push it takes may be more than its own friction can give
 // (two balls touching on a slope, the lower stuck by its own friction, the upper not).
-// The group is i and the bodies at rest that it leans on (a contact whose normal has a
-// component against i's force), and those that they lean on in turn; every contact of
+// The group is i and the bodies at rest on a face by their own friction that it leans on
+// (a contact whose normal has a component against i's force and one along the other's
+// face), and those that they lean on in turn; held bodies and bodies on bodies stay fixed
+// supports (README, Known limits); every contact of
 // every member (faces, static or non-leaning bodies as fixed supports, member pairs) gets
 // a normal and a static friction row, and the acceleration-level contact problem is
 // solved by projected Gauss-Seidel, as in try_hold_group: held iff every member ends at
@@ -326,13 +328,19 @@ bool leaning_group_holds(World& w, std::uint32_t i, std::span<const HeldContact>
     const double am = length(a);
     return am > 0.0 && -dot(n, a) > 1e-12 * am;
   };
-  const auto movable = [&](std::uint32_t other) {
-    return !(other & kBodySupport) && other < w.size() && w.dynamic(other) && w.stationary(other);
+  // A body at rest on a face by its own friction, pushed with a component along that face
+  // (a push along the face's normal the face takes whole: a column on a floor is not
+  // judged again, nor solved at mass ratios where Gauss-Seidel crawls).
+  const auto movable_along = [&](std::uint32_t other, Vec2 n) {
+    if ((other & kBodySupport) || other >= w.size() || !w.dynamic(other) || !w.stuck(other) || w.on_body(other)) {
+      return false;
+    }
+    return std::fabs(cross(n, w.support_n[other])) > 1e-9;
   };
   thread_local std::vector<std::uint32_t> members, all;
   members.assign(1, i);
   for (const HeldContact& c : contacts) {
-    if (movable(c.other) && leans(i, c.n) &&
+    if (movable_along(c.other, c.n) && leans(i, c.n) &&
         std::find(members.begin(), members.end(), c.other) == members.end()) {
       members.push_back(c.other);
     }
@@ -377,7 +385,7 @@ bool leaning_group_holds(World& w, std::uint32_t i, std::span<const HeldContact>
     mus.clear();
     touching_supports(w, m, all, tmp, mus);
     for (const HeldContact& c : tmp) {
-      if (movable(c.other) && leans(m, c.n) && index_of(c.other) < 0) {
+      if (movable_along(c.other, c.n) && leans(m, c.n) && index_of(c.other) < 0) {
         members.push_back(c.other);
         if (members.size() > kMaxLeaning) return true;   // too many to judge here
       }
