@@ -304,6 +304,152 @@ bool clear_of_everything(World& w, std::uint32_t i, std::span<const std::uint32_
 
 }  // namespace
 
+namespace {
+
+// Whether body i, about to be held by `contacts` (its static friction cones hold it
+// against each as against a fixed support), is still held once the non-static bodies it
+// leans on are judged with its load: a body at rest on a face by its own friction, or
+// held, only looks fixed; the push it takes may be more than its own friction can give
+// (two balls touching on a slope, the lower stuck by its own friction, the upper not).
+// The group is i and the bodies at rest on a face by their own friction that it leans on
+// (a contact whose normal has a component against i's force and one along the other's
+// face), and those that they lean on in turn; held bodies and bodies on bodies stay fixed
+// supports (README, Known limits); every contact of
+// every member (faces, static or non-leaning bodies as fixed supports, member pairs) gets
+// a normal and a static friction row, and the acceleration-level contact problem is
+// solved by projected Gauss-Seidel, as in try_hold_group: held iff every member ends at
+// rest. A group of more than kMaxLeaning members is not judged (each member only on its
+// own, as before: README, Known limits).
+bool leaning_group_holds(World& w, std::uint32_t i, std::span<const HeldContact> contacts,
+                         std::span<const double> mu) {
+  constexpr std::size_t kMaxLeaning = 16;
+  const auto leans = [&](std::uint32_t body, Vec2 n) {   // a contact that takes part of body's force
+    const Vec2 a = w.acc[body];
+    const double am = length(a);
+    return am > 0.0 && -dot(n, a) > 1e-12 * am;
+  };
+  // A body at rest on a face by its own friction, pushed with a component along that face
+  // (a push along the face's normal the face takes whole: a column on a floor is not
+  // judged again, nor solved at mass ratios where Gauss-Seidel crawls).
+  const auto movable_along = [&](std::uint32_t other, Vec2 n) {
+    if ((other & kBodySupport) || other >= w.size() || !w.dynamic(other) || !w.stuck(other) || w.on_body(other)) {
+      return false;
+    }
+    // On a frictionless face it is at rest only because nothing pushes it along: left a
+    // fixed support, as before (open: README, The hunt for wrong greens).
+    if (!(coefficients(w, other, w.statics.segments[w.support[other]]).holding > 0.0)) return false;
+    return std::fabs(cross(n, w.support_n[other])) > 1e-9;
+  };
+  thread_local std::vector<std::uint32_t> members, all;
+  members.assign(1, i);
+  for (const HeldContact& c : contacts) {
+    if (movable_along(c.other, c.n) && leans(i, c.n) &&
+        std::find(members.begin(), members.end(), c.other) == members.end()) {
+      members.push_back(c.other);
+    }
+  }
+  if (members.size() == 1) return true;   // only fixed supports
+  const std::size_t n = w.size();
+  // The bodies near a member: a scan (only groups that lean on bodies at rest get here).
+  const auto near_of = [&](std::uint32_t m) {
+    all.clear();
+    const double reach = w.radius[m] + 1e-9 * (w.radius[m] + w.length_scale);
+    for (std::uint32_t j = 0; j < n; ++j) {
+      if (j == m || !w.alive(j) || !w.stationary(j)) continue;
+      const Vec2 d = w.pos[j] - w.pos[m];
+      const double R = reach + w.radius[j];
+      if (std::fabs(d.x) <= R && std::fabs(d.y) <= R) all.push_back(j);
+    }
+  };
+  struct Row {
+    std::int32_t a, b;   // member indices; a = -1: a fixed support
+    Vec2 d;
+    double mu;
+    bool tangent;
+  };
+  thread_local std::vector<Row> rows;
+  thread_local std::vector<HeldContact> tmp;
+  thread_local std::vector<double> mus;
+  rows.clear();
+  const auto index_of = [&](std::uint32_t x) -> std::int32_t {
+    if ((x & kBodySupport) || x >= n) return -1;
+    const auto it = std::find(members.begin(), members.end(), x);
+    return it == members.end() ? -1 : static_cast<std::int32_t>(it - members.begin());
+  };
+  const auto add = [&](std::int32_t a, std::int32_t b, Vec2 nrm, double m) {
+    rows.push_back({a, b, nrm, m, false});
+    if (m > 0.0) rows.push_back({a, b, perp(nrm), m, true});
+  };
+  // Membership first (breadth first), then every member's contacts.
+  for (std::size_t q = 1; q < members.size(); ++q) {
+    const std::uint32_t m = members[q];
+    near_of(m);
+    tmp.clear();
+    mus.clear();
+    touching_supports(w, m, all, tmp, mus);
+    for (const HeldContact& c : tmp) {
+      if (movable_along(c.other, c.n) && leans(m, c.n) && index_of(c.other) < 0) {
+        members.push_back(c.other);
+        if (members.size() > kMaxLeaning) return true;   // too many to judge here
+      }
+    }
+  }
+  for (std::size_t k = 0; k < contacts.size(); ++k) add(index_of(contacts[k].other), 0, contacts[k].n, mu[k]);
+  for (std::size_t q = 1; q < members.size(); ++q) {
+    const std::uint32_t m = members[q];
+    near_of(m);
+    tmp.clear();
+    mus.clear();
+    touching_supports(w, m, all, tmp, mus);
+    for (std::size_t k = 0; k < tmp.size(); ++k) {
+      const std::int32_t o = index_of(tmp[k].other);
+      if (o >= 0 && static_cast<std::size_t>(o) < q) continue;   // the pair's row is there already
+      add(o, static_cast<std::int32_t>(q), tmp[k].n, mus[k]);
+    }
+  }
+  thread_local std::vector<Vec2> acc;
+  thread_local std::vector<double> lam, Akk;
+  const std::size_t M = members.size();
+  acc.resize(M);
+  for (std::size_t q = 0; q < M; ++q) acc[q] = w.acc[members[q]];
+  const auto inv = [&](std::int32_t x) { return x < 0 ? 0.0 : w.inv_mass[members[static_cast<std::size_t>(x)]]; };
+  lam.assign(rows.size(), 0.0);
+  Akk.resize(rows.size());
+  for (std::size_t k = 0; k < rows.size(); ++k) Akk[k] = inv(rows[k].a) + inv(rows[k].b);
+  double amax = 0.0;
+  for (std::size_t q = 0; q < M; ++q) amax = std::max(amax, length(acc[q]));
+  for (int iter = 0; iter < 20000; ++iter) {
+    double change = 0.0;
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const Row& r = rows[k];
+      if (!(Akk[k] > 0.0)) continue;
+      const Vec2 ab = acc[static_cast<std::size_t>(r.b)];
+      const Vec2 aa = r.a < 0 ? Vec2{} : acc[static_cast<std::size_t>(r.a)];
+      const double wk = dot(ab - aa, r.d);
+      double l;
+      if (r.tangent) {
+        const double bound = r.mu * lam[k - 1];
+        l = std::clamp(lam[k] - wk / Akk[k], -bound, bound);
+      } else {
+        l = std::max(0.0, lam[k] - wk / Akk[k]);
+      }
+      const double dl = l - lam[k];
+      if (dl == 0.0) continue;
+      lam[k] = l;
+      if (r.a >= 0) acc[static_cast<std::size_t>(r.a)] -= (dl * inv(r.a)) * r.d;
+      acc[static_cast<std::size_t>(r.b)] += (dl * inv(r.b)) * r.d;
+      change = std::max(change, std::fabs(dl) * Akk[k]);
+    }
+    if (change <= 1e-14 * amax) break;
+  }
+  for (std::size_t q = 0; q < M; ++q) {
+    if (length(acc[q]) > 1e-9 * length(w.acc[members[q]])) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near, bool settle_into_pocket) {
   if (!w.dynamic(i) || w.is_held(i) || w.acc.empty()) return false;
   const Vec2 a = w.acc[i];
@@ -334,6 +480,8 @@ bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_
     }
     return in_cone(d, gens, 1e-12);
   };
+  const Vec2 p_start = w.pos[i];
+  const bool on_face = w.supported(i) && !w.on_body(i);
   bool held = holds_here();
   if (!held && settle_into_pocket) {
     // Inelastic collapse into a pocket: a slow body on one support that cannot hold it
@@ -371,6 +519,14 @@ bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_
       held = holds_here();
       if (!held) w.pos[i] = p0;
     }
+  }
+  // Only for a body on a face (a ball pushing another along a slope): a free body held on
+  // bodies at rest keeps the old test (open: a ball on two balls on a floor whose friction
+  // cannot keep them from spreading is held; judged as a group it falls between them by
+  // micro-bounces that gain energy, README, The hunt for wrong greens).
+  if (held && on_face && !leaning_group_holds(w, i, contacts, mu)) {
+    w.pos[i] = p_start;   // (back from a pocket it was moved to)
+    held = false;
   }
   if (!held) return false;
   release_support(w, i);
@@ -929,6 +1085,103 @@ bool hold_pass(World& w, const StepContext& ctx) {
   return changed;
 }
 
+// Bodies on faces pressed together while they slide (a ball pushing another down a
+// slope, the lower one's friction too much for the upper alone and too little for both):
+// rigid bodies in contact move together, so each member feels its neighbours' push as a
+// force. The pair forces P_k >= 0 (along each pair's normal; no friction between them)
+// are solved by Gauss-Seidel so that no pressed pair's relative acceleration along its
+// normal stays negative, each member's acceleration being its face's law
+// (support_acceleration: kinetic friction sliding, static from rest) under its own force
+// plus the pushes; the pushes are then added to the members' force accelerations for
+// the step and their paths recomputed, so every later event of the step (a stop, a hold)
+// sees them. Pairs are those touching, with no relative normal velocity, pressed by their
+// own paths. Constant forces only (under drag a face's law is integrated in sub-steps).
+void push_trains(World& w) {
+  const std::size_t n = w.size();
+  thread_local std::vector<std::uint32_t> cand, parent;
+  thread_local std::vector<Vec2> push;
+  struct Pair {
+    std::uint32_t i, j;
+    Vec2 nrm;   // from i to j
+    double P;
+  };
+  thread_local std::vector<Pair> pairs;
+  cand.clear();
+  pairs.clear();
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (w.dynamic(i) && w.supported(i) && !w.on_body(i)) cand.push_back(i);
+  }
+  if (cand.size() < 2) return;
+  std::sort(cand.begin(), cand.end(), [&](std::uint32_t a, std::uint32_t b) {
+    const double la = w.pos[a].x - w.radius[a], lb = w.pos[b].x - w.radius[b];
+    return la < lb || (la == lb && a < b);
+  });
+  for (std::size_t x = 0; x < cand.size(); ++x) {
+    const std::uint32_t i = cand[x];
+    const double right = w.pos[i].x + w.radius[i];
+    for (std::size_t y = x + 1; y < cand.size(); ++y) {
+      const std::uint32_t j = cand[y];
+      const double tol_reach = 1e-9 * (w.radius[i] + w.radius[j] + w.length_scale);
+      if (w.pos[j].x - w.radius[j] > right + tol_reach) break;
+      if ((w.flags[i] & kPoint) && (w.flags[j] & kPoint)) continue;
+      if (((w.flags[i] | w.flags[j]) & kParticle) && related_bodies(w, i, j)) continue;
+      if (w.any_rules && !w.response(w.group[i], w.group[j]).collide) continue;
+      const Vec2 d = w.pos[j] - w.pos[i];
+      const double dl = length(d);
+      const double R = w.radius[i] + w.radius[j];
+      if (!(dl > 0.0) || std::fabs(dl - R) > 1e-9 * (R + w.length_scale)) continue;
+      const Vec2 nrm = d / dl;
+      const double vn = dot(w.vel[j] - w.vel[i], nrm);
+      if (std::fabs(vn) > 1e-12 * (length(w.vel[i]) + length(w.vel[j]))) continue;
+      if (!(dot(w.apath[j] - w.apath[i], nrm) < 0.0)) continue;   // not pressed
+      pairs.push_back({i, j, nrm, 0.0});
+    }
+  }
+  if (pairs.empty()) return;
+  push.assign(n, Vec2{});
+  const auto acc_of = [&](std::uint32_t m) {
+    const Vec2 t = perp(w.support_n[m]);
+    return support_acceleration(w, m, w.acc[m] + push[m], dot(w.vel[m], t));
+  };
+  double amax = 0.0;
+  for (const Pair& p : pairs) amax = std::max({amax, length(w.acc[p.i]), length(w.acc[p.j])});
+  for (int iter = 0; iter < 100000; ++iter) {
+    double change = 0.0;
+    for (Pair& p : pairs) {
+      const double wk = dot(acc_of(p.j) - acc_of(p.i), p.nrm);
+      const double ti = dot(perp(w.support_n[p.i]), p.nrm), tj = dot(perp(w.support_n[p.j]), p.nrm);
+      const double K = ti * ti * w.inv_mass[p.i] + tj * tj * w.inv_mass[p.j];
+      if (!(K > 1e-12 * (w.inv_mass[p.i] + w.inv_mass[p.j]))) continue;
+      const double P = std::max(0.0, p.P - wk / K);
+      const double dP = P - p.P;
+      if (dP == 0.0) continue;
+      p.P = P;
+      push[p.i] -= (dP * w.inv_mass[p.i]) * p.nrm;
+      push[p.j] += (dP * w.inv_mass[p.j]) * p.nrm;
+      change = std::max(change, std::fabs(dP) * K);
+    }
+    if (change <= 1e-15 * amax) break;
+  }
+  for (const Pair& p : pairs) {
+    for (std::uint32_t m : {p.i, p.j}) {
+      if (push[m].x == 0.0 && push[m].y == 0.0) continue;
+      w.acc[m] += push[m];
+      push[m] = {};
+      support_path(w, m);
+    }
+  }
+  // A pair on one line moves as one: the same velocity and acceleration to the bit (else
+  // round-off reads as an approach and the touching pair is met as an impact at once).
+  for (const Pair& p : pairs) {
+    if (w.support_n[p.i] != w.support_n[p.j]) continue;
+    const Vec2 dv = w.vel[p.j] - w.vel[p.i], da = w.apath[p.j] - w.apath[p.i];
+    const double vs = length(w.vel[p.i]) + length(w.vel[p.j]), as = length(w.apath[p.i]) + length(w.apath[p.j]);
+    if (length(dv) > 1e-12 * vs || length(da) > 1e-12 * as) continue;
+    w.vel[p.j] = w.vel[p.i];
+    w.apath[p.j] = w.apath[p.i];
+  }
+}
+
 }  // namespace
 
 void apply_supports(World& w, const StepContext& ctx) {
@@ -988,6 +1241,7 @@ void apply_supports(World& w, const StepContext& ctx) {
     }
     if (hold_pass(w, ctx)) changed = true;
   }
+  if (!w.varying_forces) push_trains(w);
 }
 
 double support_stop_time(const World& w, std::uint32_t i, double t, double T) {

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
+#include <vector>
 
 #include "scene_fixture.hpp"
 
@@ -195,5 +197,130 @@ TEST(CoreResting, APointStartedExactlyOnAFloorNeverCrossesIt) {
   }
   EXPECT_EQ(cases, 4 * 2 * 2 * 3 * 6);
 }
+
+// Balls in a row touching along a slope, each with its own friction against it, none
+// between them, released at rest (hunt: slope_pair_push). Rigid Coulomb: a ball behind
+// (up the slope) that would accelerate faster than the one in front pushes it, and
+// pressed neighbours move as one block whose acceleration down the slope is
+// max(0, g (sum m sin - sum mu m cos) / sum m) (held iff the block's friction can hold its
+// weight); blocks form by pooling adjacent violators from the front (a block behind
+// faster than the one in front joins it). Each ball's path is then x = a t^2 / 2 along the
+// slope, touching balls of a block stay touching, and blocks separate by (a_f - a_b) t^2 / 2.
+// Grid: slopes 5-60 degrees, mu in both orders, mass ratios 0.01-100, 2 and 3 balls,
+// the balls listed front first and back first. Cases within 1e-6 g of a threshold are
+// not judged (held or sliding, touching or parting, is round-off there).
+static void balls_in_a_row_on_a_slope(std::size_t balls) {
+  const std::vector<std::vector<double>> mus = {
+      {0.5, 0.2},  {0.2, 0.5},   {0.05, 1.0},     {1.0, 0.05},      {0.3, 0.3},      {2.0, 0.1},
+      {0.1, 2.0},  {0.7, 0.0},   {0.5, 0.2, 0.2}, {0.2, 0.5, 0.2},  {0.2, 0.2, 0.5}, {1.0, 0.1, 0.5},
+      {0.1, 1.0, 0.1}, {0.05, 0.05, 2.0}, {2.0, 0.05, 0.05}, {0.6, 0.3, 0.0}};
+  const std::vector<std::vector<double>> masses = {{1, 1, 1}, {0.01, 1, 100}, {100, 1, 0.01}, {1, 100, 1}, {1, 0.01, 1}};
+  int judged = 0, skipped = 0, held_all = 0, slid_all = 0, parted = 0;
+  for (double deg : {5.0, 10.0, 20.0, 35.0, 50.0, 60.0}) {
+    const double th = deg * std::numbers::pi / 180.0;
+    const Vec2 t{std::cos(th), std::sin(th)}, nrm{-std::sin(th), std::cos(th)};
+    for (const auto& mu : mus) {
+      if (mu.size() != balls) continue;
+      for (const auto& mass : masses) {
+        const std::size_t N = mu.size();
+        // The closed form: blocks pooled from the front (ball 0, lowest) backwards.
+        const auto alone = [&](std::size_t b, std::size_t e) {   // unclipped, down the slope
+          double M = 0.0, F = 0.0;
+          for (std::size_t k = b; k < e; ++k) {
+            M += mass[k];
+            F += mass[k] * g * (std::sin(th) - mu[k] * std::cos(th));
+          }
+          return F / M;
+        };
+        std::vector<std::pair<std::size_t, std::size_t>> blocks;   // [begin, end)
+        bool near_threshold = false;
+        for (std::size_t k = 0; k < N; ++k) {
+          blocks.push_back({k, k + 1});
+          while (blocks.size() > 1) {
+            const auto [fb, fe] = blocks[blocks.size() - 2];
+            const auto [bb, be] = blocks.back();
+            const double af = std::max(0.0, alone(fb, fe)), ab = std::max(0.0, alone(bb, be));
+            if (std::fabs(ab - af) < 1e-6 * g && (ab > 0.0 || af > 0.0)) near_threshold = true;
+            if (!(ab > af)) break;
+            blocks.pop_back();
+            blocks.back().second = be;
+          }
+        }
+        std::vector<double> a(N);
+        for (const auto& [b, e] : blocks) {
+          const double u = alone(b, e);
+          if (std::fabs(u) < 1e-6 * g) near_threshold = true;
+          for (std::size_t k = b; k < e; ++k) a[k] = std::max(0.0, u);
+        }
+        if (near_threshold) {
+          ++skipped;
+          continue;
+        }
+        if (blocks.size() == 1) (a[0] == 0.0 ? held_all : slid_all)++;
+        if (blocks.size() > 1) ++parted;
+        for (bool front_first : {true, false}) {
+          std::vector<BodyDef> bodies;
+          std::vector<std::size_t> index(N);   // ball k (0: front, lowest) -> body index
+          std::vector<Vec2> start(N);
+          for (std::size_t q = 0; q < N; ++q) {
+            const std::size_t k = front_first ? q : N - 1 - q;
+            start[k] = (20.0 + static_cast<double>(k)) * t + 0.5 * nrm;
+            bodies.push_back(circle("b" + std::to_string(k), start[k], {}, 0.5, mass[k], 0.0));
+            index[k] = q;
+          }
+          Scene sc = scene_of(bodies, {wall("slope", {0.0, 0.0}, 40.0 * t, 0.0)}, {0.0, -g});
+          for (std::size_t k = 0; k < N; ++k) {
+            MaterialOverride m;
+            m.a = "b" + std::to_string(k);
+            m.b = "slope";
+            m.friction = mu[k];
+            sc.materials.push_back(m);
+            for (std::size_t l = k + 1; l < N; ++l) {
+              MaterialOverride p;
+              p.a = "b" + std::to_string(k);
+              p.b = "b" + std::to_string(l);
+              p.friction = 0.0;
+              sc.materials.push_back(p);
+            }
+          }
+          const std::string where = std::to_string(deg) + " deg, " + std::to_string(N) + " balls, mu0 " +
+                                    std::to_string(mu[0]) + " mu1 " + std::to_string(mu[1]) + " mass0 " +
+                                    std::to_string(mass[0]) + " mass1 " + std::to_string(mass[1]) +
+                                    (front_first ? ", front first" : ", back first");
+          Sim sim(sc);
+          double worst_overlap = 0.0, worst = 0.0;
+          for (int step = 1; step <= 60; ++step) {
+            sim.step(1.0 / 60.0);
+            const double time = step / 60.0;
+            for (std::size_t k = 0; k < N; ++k) {
+              const BodyState b = sim.state(index[k]);
+              const Vec2 expect = start[k] - (0.5 * a[k] * time * time) * t;
+              worst = std::max({worst, length(b.position - expect), length(b.velocity - (-a[k] * time) * t)});
+              if (k + 1 < N) {
+                const double gap = length(sim.state(index[k + 1]).position - b.position) - 1.0;
+                worst_overlap = std::max(worst_overlap, -gap);
+                worst = std::max(worst, std::fabs(gap - 0.5 * (a[k] - a[k + 1]) * time * time));
+              }
+            }
+          }
+          EXPECT_LE(worst, 1e-9) << where << ": a " << a[0] << " " << a[1] << (N > 2 ? " " + std::to_string(a[2]) : "");
+          EXPECT_LE(worst_overlap, 1e-9) << where;
+          ++judged;
+        }
+      }
+    }
+  }
+  EXPECT_GT(held_all, 20);
+  EXPECT_GT(slid_all, 20);
+  EXPECT_GT(parted, 20);
+  EXPECT_LT(skipped, 30);   // ties (two balls alike behind one another), not judged
+  EXPECT_GT(judged, 350);
+}
+
+TEST(CoreResting, TwoBallsOnASlopeMeetRigidCoulomb) { balls_in_a_row_on_a_slope(2); }
+
+// Open: three balls fail where two behind slide alike (their contact is not "pressed" when
+// push_trains collects pairs, so the back one never joins), and some run for minutes.
+TEST(CoreResting, DISABLED_ThreeBallsInARowOnASlopeMeetRigidCoulomb) { balls_in_a_row_on_a_slope(3); }
 
 }  // namespace physval::test

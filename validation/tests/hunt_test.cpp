@@ -257,11 +257,13 @@ TEST(Hunt, CoreMeetsTheHuntsVTroughClosedForm) { expect_core_meets("v_trough_ine
 
 TEST(Hunt, CoreMeetsThePointOnFloorClosedForm) { expect_core_meets("point_on_floor_exact.toml"); }
 
-// slope_pair_push (open): two balls at rest touching on a slope, the upper with too little
+// slope_pair_push: two balls at rest touching on a slope, the upper with too little
 // friction to stay, the lower with enough for itself but not for both: they must slide
-// together at 0.1287 m/s^2; core holds both at rest for ever, `ok` (a held body leans on a
-// stuck one as on a fixed support, and the stuck one is never judged with that load).
-TEST(Hunt, DISABLED_CoreMeetsTheSlopePairClosedForm) { expect_core_meets("slope_pair_push.toml"); }
+// together at 0.1287 m/s^2; core held both at rest for ever, `ok` (a held body leaned on a
+// stuck one as on a fixed support, and the stuck one was never judged with that load).
+// Fixed: such a hold is judged as a group, and bodies on faces pressed together slide as
+// one (resting_contact.cpp: leaning_group_holds, push_trains).
+TEST(Hunt, CoreMeetsTheSlopePairClosedForm) { expect_core_meets("slope_pair_push.toml"); }
 
 }  // namespace
 }  // namespace physval
