@@ -277,8 +277,8 @@ static void balls_in_a_row_on_a_slope(std::size_t balls) {
             sc.materials.push_back(m);
             for (std::size_t l = k + 1; l < N; ++l) {
               MaterialOverride p;
-              p.a = "b" + std::to_string(k);
-              p.b = "b" + std::to_string(l);
+              p.a = m.a;
+              p.b = bodies[index[l]].name;
               p.friction = 0.0;
               sc.materials.push_back(p);
             }
