@@ -120,7 +120,6 @@ TEST(CoreResting, RollsOffTheEndAndFalls) {
   EXPECT_LT(sim.state("ball").position.y, 0.0);
   EXPECT_NEAR(sim.state("ball").velocity.x, 2.0, 1e-12);
 }
-
 }  // namespace physval::test
 
 namespace physval::test {
@@ -322,5 +321,81 @@ TEST(CoreResting, TwoBallsOnASlopeMeetRigidCoulomb) { balls_in_a_row_on_a_slope(
 // Open: three balls fail where two behind slide alike (their contact is not "pressed" when
 // push_trains collects pairs, so the back one never joins), and some run for minutes.
 TEST(CoreResting, DISABLED_ThreeBallsInARowOnASlopeMeetRigidCoulomb) { balls_in_a_row_on_a_slope(3); }
+
+// Three equal balls (r 0.5, m 1, e 0): two on a floor touching each other at x = -0.5 and
+// 0.5, the third on top of them (hunt: pyramid_of_three). Non-rotating circles, no friction
+// between the balls, floor friction mu. Rigid Coulomb by hand: each contact normal to the
+// top is 30 degrees from the vertical; at rest each bottom ball is pushed out by
+// g / (2 sqrt 3) = 0.289 g and pressed on the floor by 1.5 g, so the pyramid holds iff
+// mu >= 1 / (3 sqrt 3) = 0.19245. Below that, with N the top's contact force and the
+// bottom balls sliding out (a_b = sqrt 3 a_t keeps the contacts):
+//   top    a_t = g - sqrt 3 N,   bottom  a_b = N / 2 - mu (g + sqrt 3 N / 2)
+//   =>     a_t = g (1 - 3 sqrt 3 mu) / (7 - sqrt 3 mu)   (g / 7 frictionless)
+// Checked: the velocities after a first step of 1e-4 s meet a t to 1e-9 m/s (a changes
+// only at O(t^2) from rest); then to 4 s: no energy gained, no overlap over 1e-9 m, the
+// mirror symmetry and a renumbering to 1e-12, and the end: collapsed (top on the floor,
+// bottom balls apart) or held (nothing moved).
+// Open (README, The hunt for wrong greens): core holds the top as on fixed supports.
+TEST(CoreResting, DISABLED_PyramidOfThreeCollapsesIffRigidCoulombSays) {
+  const double s3 = std::sqrt(3.0);
+  for (double mu : {0.0, 0.1, 0.15, 0.3, 1.0}) {
+    const bool holds = mu >= 1.0 / (3.0 * s3);
+    const double at = holds ? 0.0 : g * (1.0 - 3.0 * s3 * mu) / (7.0 - s3 * mu);
+    std::vector<std::vector<BodyState>> runs;
+    for (bool top_first : {false, true}) {
+      SCOPED_TRACE("mu " + std::to_string(mu) + (top_first ? ", top listed first" : ", top listed last"));
+      std::vector<BodyDef> b = {circle("left", {-0.5, 0.5}, {}, 0.5, 1.0, 0.0),
+                                circle("right", {0.5, 0.5}, {}, 0.5, 1.0, 0.0),
+                                circle("top", {0.0, 0.5 + s3 / 2.0}, {}, 0.5, 1.0, 0.0)};
+      if (top_first) b = {b[2], b[1], b[0]};
+      Scene sc = scene_of(b, {wall("floor", {-50.0, 0.0}, {50.0, 0.0}, 0.0, mu)}, {0.0, -g});
+      Sim sim(sc);
+      const auto st = [&](const char* name) { return sim.state(name); };
+      const auto energy3 = [&]() {
+        double e = 0.0;
+        for (const char* nm : {"left", "right", "top"}) {
+          const BodyState x = st(nm);
+          e += 0.5 * length_squared(x.velocity) + g * x.position.y;
+        }
+        return e;
+      };
+      const double e0 = energy3();
+      const double h = 1e-4;
+      sim.step(h);
+      EXPECT_NEAR(st("top").velocity.y, -at * h, 1e-9);
+      EXPECT_NEAR(st("top").velocity.x, 0.0, 1e-12);
+      EXPECT_NEAR(st("right").velocity.x, s3 * at * h, 1e-9);
+      EXPECT_NEAR(st("left").velocity.x, -s3 * at * h, 1e-9);
+      double gained = 0.0, overlap = 0.0, asym = 0.0;
+      while (sim.engine.time() < 4.0 - 1e-12) {
+        sim.step(std::min(1.0 / 60.0, 4.0 - sim.engine.time()));
+        gained = std::max(gained, energy3() - e0);
+        const BodyState l = st("left"), r = st("right"), t = st("top");
+        overlap = std::max({overlap, 1.0 - length(l.position - r.position), 1.0 - length(l.position - t.position),
+                            1.0 - length(r.position - t.position), 0.5 - l.position.y, 0.5 - r.position.y,
+                            0.5 - t.position.y});
+        asym = std::max({asym, std::fabs(l.position.x + r.position.x), std::fabs(l.position.y - r.position.y),
+                         std::fabs(t.position.x)});
+      }
+      EXPECT_LE(gained, 1e-9);
+      EXPECT_LE(overlap, 1e-9);
+      EXPECT_LE(asym, 1e-12);
+      const BodyState l = st("left"), r = st("right"), t = st("top");
+      if (holds) {
+        EXPECT_NEAR(t.position.y, 0.5 + s3 / 2.0, 1e-9);
+        EXPECT_NEAR(r.position.x, 0.5, 1e-9);
+        EXPECT_NEAR(l.position.x, -0.5, 1e-9);
+      } else {
+        EXPECT_NEAR(t.position.y, 0.5, 1e-9);   // on the floor between them
+        EXPECT_GE(r.position.x, 1.0 - 1e-9);
+        EXPECT_LE(l.position.x, -1.0 + 1e-9);
+      }
+      runs.push_back({l, r, t});
+    }
+    for (std::size_t k = 0; k < 3; ++k) {
+      EXPECT_LE(length(runs[0][k].position - runs[1][k].position), 1e-12) << "mu " << mu << " body " << k;
+    }
+  }
+}
 
 }  // namespace physval::test
