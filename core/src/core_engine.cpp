@@ -151,6 +151,13 @@ std::vector<Setting> CoreEngine::settings() const {
 
 std::string CoreEngine::broken_guarantee() const {
   const World& w = *world_;
+  if (w.unjustified_hold != core_detail::kNone) {
+    std::ostringstream os;
+    os << "core held body '" << w.name(w.unjustified_hold) << "' at t = " << w.unjustified_hold_time
+       << " s on bodies that, judged with it, cannot hold it (rigid Coulomb: they must spread); core has no "
+          "exact model of that collapse yet, so its path is not the physics (README, The hunt for wrong greens)";
+    return os.str();
+  }
   if (!w.stats.event_cap_hit) return {};
   std::ostringstream os;
   os << "core reached its event cap (" << w.stats.events << " events) in the step ending at t = " << w.time

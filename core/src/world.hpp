@@ -230,6 +230,11 @@ struct World {
   CoreStepStats stats;
   std::int64_t cap_hits = 0;
   double first_cap_time = -1.0;
+  // The first body held on bodies that, judged with it, cannot hold it (a ball on two
+  // balls whose floor cannot keep them from spreading): core has no model for the
+  // collapse that follows, so the run reports a broken guarantee (try_hold).
+  std::uint32_t unjustified_hold = kNone;
+  double unjustified_hold_time = -1.0;
   std::int64_t max_events_seen = 0;
 
   // ---- helpers
