@@ -394,6 +394,16 @@ TEST(CoreResting, DISABLED_PyramidOfThreeCollapsesIffRigidCoulombSays) {
                                 circle("top", {0.0, 0.5 + s3 / 2.0}, {}, 0.5, 1.0, 0.0)};
       if (top_first) b = {b[2], b[1], b[0]};
       Scene sc = scene_of(b, {wall("floor", {-50.0, 0.0}, {50.0, 0.0}, 0.0, mu)}, {0.0, -g});
+      // The floor's mu on the ball-floor pairs (the pair rule sqrt(f1 f2) would give 0: the
+      // balls have none), none between the balls, as the closed form above assumes.
+      for (const char* nm : {"left", "right", "top"}) {
+        MaterialOverride m;
+        m.a = nm;
+        m.b = "floor";
+        m.friction = mu;
+        m.static_friction = mu;
+        sc.materials.push_back(m);
+      }
       Sim sim(sc);
       const auto st = [&](const char* name) { return sim.state(name); };
       const auto energy3 = [&]() {
