@@ -137,6 +137,7 @@ std::vector<Config> configs() {
 struct Final {
   std::vector<Vec2> p, v;   // canonical body order, mirrored back
   std::string failure;      // energy or momentum rule broken (empty: none)
+  bool unjustified = false; // core reported a hold it cannot justify (the run stops there)
 };
 
 std::string sci(double x) {
@@ -197,7 +198,13 @@ Final run(const Config& c, double e, double mu, const std::vector<int>& order, b
       for (const BodyState& s : sim.states) P += s.velocity;
       if (length(P - P0) > 1e-12) f.failure = "momentum changed by " + std::to_string(length(P - P0));
     }
-    if (!sim.engine.broken_guarantee().empty()) f.failure = "event cap";
+    if (const std::string b = sim.engine.broken_guarantee(); !b.empty()) {
+      if (b.find("cannot hold it") != std::string::npos) {
+        f.unjustified = true;
+        break;
+      }
+      f.failure = b;
+    }
   }
   // Elastic and frictionless: energy kept exactly.
   if (f.failure.empty() && !c.floor && e == 1.0 && mu == 0.0 && std::fabs(E_prev - E0) > 1e-12 * E0) {
@@ -235,6 +242,16 @@ TEST_P(SymmetricImpactStress, SymmetricWhateverTheNumberingAndNoEnergyGain) {
       std::iota(order.begin(), order.end(), 0);
       const Final ref = run(c, e, mu, order, false);
       EXPECT_TRUE(ref.failure.empty()) << what << ": " << ref.failure;
+      // The stack's middle ball on two floor balls (the top still falling): every contact has
+      // mu, so friction at the middle's contacts tilts their force towards the vertical by
+      // atan(mu); each bottom ball is pushed out by (W / 2) tan(30 deg - atan mu) and pressed
+      // on the floor by 1.5 W, so it holds iff tan(30 deg - atan mu) <= 3 mu: mu >= 0.13
+      // (mu 0.1: 0.451 against 0.3). Below, the bottom balls must spread; core has no exact
+      // model of that collapse yet and must say so (a broken guarantee: the run is diverged),
+      // never hold it `ok`.
+      const bool must_spread = c.name == "ball_on_stack_of_three" && mu < 0.13;
+      EXPECT_EQ(ref.unjustified, must_spread) << what;
+      if (must_spread) continue;
       // Not yet: on a frictionless floor (mu = 0 with gravity) bodies sliding on the
       // floor are left out of simultaneous sets (with them, a frictionless 10-circle pile,
       // seed 3, never settled), so the lower balls meet the top one pair by pair in body
@@ -260,6 +277,7 @@ TEST_P(SymmetricImpactStress, SymmetricWhateverTheNumberingAndNoEnergyGain) {
           for (int k : order) tag += " " + std::to_string(k);
           if (mirror) tag += " mirrored";
           EXPECT_TRUE(f.failure.empty()) << tag << ": " << f.failure;
+          EXPECT_FALSE(f.unjustified) << tag;
           if (!not_yet) {
             EXPECT_LE(worst_difference(f, ref), 1e-12) << tag;
           }
