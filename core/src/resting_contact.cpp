@@ -306,6 +306,13 @@ bool clear_of_everything(World& w, std::uint32_t i, std::span<const std::uint32_
 
 namespace {
 
+// One projected Gauss-Seidel row of an acceleration-level contact problem: a normal row's
+// multiplier stays >= 0, a tangent row's within +-bound (mu times its normal's).
+double projected_row(double lam, double w, double Akk, bool tangent, double bound) {
+  const double l = lam - w / Akk;
+  return tangent ? std::clamp(l, -bound, bound) : std::max(0.0, l);
+}
+
 // Whether body i, about to be held by `contacts` (its static friction cones hold it
 // against each as against a fixed support), is still held once the non-static bodies it
 // leans on are judged with its load: a body at rest on a face by its own friction, or
@@ -435,13 +442,7 @@ bool leaning_group_holds(World& w, std::uint32_t i, std::span<const HeldContact>
       const Vec2 ab = acc[static_cast<std::size_t>(r.b)];
       const Vec2 aa = r.a < 0 ? Vec2{} : acc[static_cast<std::size_t>(r.a)];
       const double wk = dot(ab - aa, r.d);
-      double l;
-      if (r.tangent) {
-        const double bound = r.mu * lam[k - 1];
-        l = std::clamp(lam[k] - wk / Akk[k], -bound, bound);
-      } else {
-        l = std::max(0.0, lam[k] - wk / Akk[k]);
-      }
+      const double l = projected_row(lam[k], wk, Akk[k], r.tangent, r.tangent ? r.mu * lam[k - 1] : 0.0);
       const double dl = l - lam[k];
       if (dl == 0.0) continue;
       lam[k] = l;
@@ -666,13 +667,7 @@ bool try_hold_group(World& w, std::uint32_t seed, double t, double dt, const Nea
       const Row& r = rows[k];
       if (!(Akk[k] > 0.0)) continue;
       const double wk = rel(r);
-      double l;
-      if (r.tangent) {
-        const double bound = gc[r.c].mu * lam[k - 1];
-        l = std::clamp(lam[k] - wk / Akk[k], -bound, bound);
-      } else {
-        l = std::max(0.0, lam[k] - wk / Akk[k]);
-      }
+      const double l = projected_row(lam[k], wk, Akk[k], r.tangent, r.tangent ? gc[r.c].mu * lam[k - 1] : 0.0);
       const double dl = l - lam[k];
       if (dl == 0.0) continue;
       lam[k] = l;
