@@ -955,10 +955,11 @@ bool resting_component(World& w, const BodiesByX& bx, std::uint32_t seed, std::v
 
 // Whether a resting component (sorted members; faces and static bodies fixed) can be held
 // by rigid Coulomb contact: a normal force >= 0 at every contact and a static friction
-// force within mu times it, every member's acceleration zero. The same acceleration-level
-// contact problem, rows, projected Gauss-Seidel and tolerances as leaning_group_holds
-// (held iff every member ends with |a| <= 1e-9 of its force acceleration), with no member
-// taken as fixed. `residual`: the largest acceleration left on a member.
+// force within mu times it, every member's acceleration zero. The tolerances of
+// leaning_group_holds (held iff every member ends with |a| <= 1e-9 of its force
+// acceleration; Gauss-Seidel stops at 1e-14 of the largest, or after 20000 sweeps), with no
+// member taken as fixed. kCannotHold only with a certificate (below), else kUndecided.
+// `residual`: the largest acceleration left on a member by Gauss-Seidel.
 enum class Verdict { kHeld, kCannotHold, kUndecided };
 
 Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint32_t> members, double& residual) {
