@@ -147,14 +147,18 @@ bool hold_reported(const Trace& t, bool no_hold) {
 Trace check_all_variants(const Scene& scene, int n_steps, double rise, double same, const std::string& where,
                          bool bodies_too = true, bool no_hold = false) {
   const Trace base = run(scene, {}, n_steps);
-  if (!hold_reported(base, no_hold)) EXPECT_EQ(base.broken, "") << where;
+  if (!hold_reported(base, no_hold)) {
+    EXPECT_EQ(base.broken, "") << where;
+  }
   EXPECT_LE(base.worst_overlap, 1e-9) << where;
   EXPECT_LE(base.worst_rise, rise) << where;
   for (int bits = 1; bits < 8; ++bits) {
     const Variant v{(bits & 1) != 0, (bits & 2) != 0, (bits & 4) != 0};
     if (v.reverse_bodies && !bodies_too) continue;
     const Trace t = run(scene, v, n_steps);
-    if (!hold_reported(t, no_hold)) EXPECT_EQ(t.broken, "") << where << v.str();
+    if (!hold_reported(t, no_hold)) {
+      EXPECT_EQ(t.broken, "") << where << v.str();
+    }
     if (hold_reported(t, no_hold) || hold_reported(base, no_hold)) continue;   // stopped at the report
     EXPECT_LE(t.worst_overlap, 1e-9) << where << v.str();
     EXPECT_LE(t.worst_rise, rise) << where << v.str();
