@@ -1045,27 +1045,41 @@ Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint
     }
     converged = change <= 1e-14 * amax;
   }
-  const auto all_at_rest = [&](std::span<const Vec2> a) {
+  // At rest: within 1e-9 of its force acceleration, or within the round-off of summing its
+  // contact forces (64 eps x their sum over its mass). Without the latter a ball of 1 kg
+  // under one of 1e9 kg in a column (held exactly) was never "at rest": 1e-9 of g is 1e-19
+  // of the forces on it, and the run was reported as a hold core could not show.
+  thread_local std::vector<double> force_sum;
+  const auto all_at_rest = [&](std::span<const Vec2> a, std::span<const double> l) {
+    force_sum.assign(M, 0.0);
+    for (std::size_t k = 0; k < C; ++k) {
+      const double f = std::fabs(l[k]) * length(cols[k].d);
+      if (cols[k].a >= 0) force_sum[static_cast<std::size_t>(cols[k].a)] += f * inv(cols[k].a);
+      force_sum[static_cast<std::size_t>(cols[k].b)] += f * inv(cols[k].b);
+    }
     for (std::size_t q = 0; q < M; ++q) {
-      if (length(a[q]) > 1e-9 * length(w.acc[members[q]])) return false;
+      if (length(a[q]) > 1e-9 * length(w.acc[members[q]]) + 64.0 * 2.220446049250313e-16 * force_sum[q]) return false;
     }
     return true;
   };
-  bool held = all_at_rest(acc);
+  bool held = all_at_rest(acc, lam);
   residual = 0.0;
   for (std::size_t q = 0; q < M; ++q) residual = std::max(residual, length(acc[q]));
-  if (!held) {
+  for (int pass = 0; pass < 2 && !held; ++pass) {
     // Gauss-Seidel crawls along long chains (a column of 50 balls: its rate is 1 - (pi /
     // 101)^2 a sweep). Polish: keep the contacts it loads, and solve for the corrections to
     // their forces that cancel the rest exactly (least squares by conjugate gradients, CGLS,
     // in mass-weighted form: the member's sqrt(m) a). Held iff every corrected force is
     // still >= 0 and, summed afresh, leaves every member at rest within the same 1e-9.
+    // A second pass takes every contact: with masses 1e9 apart Gauss-Seidel had not loaded
+    // some contacts a column needs at all (a step moves the light member 1e9 times more
+    // than the heavy one), and the polish over the loaded ones could not reach rest.
     thread_local std::vector<std::size_t> act;
     thread_local std::vector<double> x, pdir, sv, lam2;
     thread_local std::vector<Vec2> res, qv, acc2;
     act.clear();
     for (std::size_t k = 0; k < C; ++k) {
-      if (lam[k] > 0.0) act.push_back(k);
+      if (pass == 1 || lam[k] > 0.0) act.push_back(k);
     }
     const std::size_t P = act.size();
     const auto sq = [&](std::int32_t m) { return std::sqrt(inv(m)); };
@@ -1124,7 +1138,7 @@ Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint
         if (c.a >= 0) acc2[static_cast<std::size_t>(c.a)] -= (lam2[k] * inv(c.a)) * c.d;
         acc2[static_cast<std::size_t>(c.b)] += (lam2[k] * inv(c.b)) * c.d;
       }
-      held = all_at_rest(acc2);
+      held = all_at_rest(acc2, lam2);
     }
   }
   if (held) return Verdict::kHeld;
