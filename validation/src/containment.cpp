@@ -386,14 +386,21 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
       // when both steps were straight (neither body met anything in it), each bend added.
       // A point (radius 0) has passed into a circle when it gets half-way to its centre.
       const double smaller = std::min(ri, rj) > 0.0 ? std::min(ri, rj) : 0.5 * std::max(ri, rj);
+      // The bends (six square roots) are worked out only when they can decide: the path's
+      // closest approach plus a bend (>= 0) is never below the approach alone, so when the
+      // centres are inside now, or the path never comes inside, the answer is the same.
       double closest = ri + rj - depth;
-      if (const double off = bend(i) + bend(j); off < 0.5 * smaller) {
+      const double inside = smaller - eps_;
+      if (!(closest < inside)) {
         const Vec2 d0 = before(i) - before(j), dd = (xi - xj) - d0;
         const double len2 = dot(dd, dd);
         const double u = len2 > 0.0 ? std::clamp(-dot(d0, dd) / len2, 0.0, 1.0) : 1.0;
-        closest = std::min(closest, length(d0 + dd * u) + off);
+        const double along = length(d0 + dd * u);
+        if (along < inside) {
+          if (const double off = bend(i) + bend(j); off < 0.5 * smaller) closest = std::min(closest, along + off);
+        }
       }
-      if (closest < smaller - eps_ && smaller > 0.0) {
+      if (closest < inside && smaller > 0.0) {
         for (const std::size_t k : {i, j}) {
           if (escaped_[k]) continue;
           escaped_[k] = 1;
