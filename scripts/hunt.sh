@@ -20,6 +20,8 @@
 #             must meet it to 1e-6 or better
 #   draglin, dragquad, thrust   the converged reference must meet the closed form
 #   every closed-form run: an engine's position_divergence must see its miss
+#   box       a point or a ball at 5-5000 m/s in a box of walls (0.3-20 m), axis, 17 deg and
+#             corners, with and without gravity: core never leaves, no engine is ok outside it
 set -euo pipefail
 build=build
 jobs=$(nproc)
@@ -391,6 +393,33 @@ to = [0.0, 0.0]
 restitution = 0.0
 friction = {mu}
 """, [vc * s, r - 0.5 * g * s * s], [vc, -g * s], 1e-8)
+# box: a point or a 5 cm ball at 5-5000 m/s in a box of four walls (half-width 0.3-20 m),
+# e = 1, with and without gravity, along an axis, at 17 degrees, and into the corners.
+for v in [5, 50, 200, 1000, 5000]:
+    for size in [0.3, 2.0, 20.0]:
+        for ang in [0, 17, 45]:
+            for shape in ["circle", "point"]:
+                for grav in [0.0, 9.8]:
+                    a = math.radians(ang)
+                    body = f"radius = {min(0.05, size / 10)}" if shape == "circle" else 'shape = "point"'
+                    c = [(-size, -size), (size, -size), (size, size), (-size, size)]
+                    walls = "".join(f"""[[walls]]
+name = "w{k}"
+from = [{c[k][0]}, {c[k][1]}]
+to = [{c[(k + 1) % 4][0]}, {c[(k + 1) % 4][1]}]
+""" for k in range(4))
+                    n = f"box_{v}_{size}_{ang}_{shape}_{int(grav)}".replace(".", "p")
+                    write(n, f"""name = "{n}"
+duration = 2.0
+[world]
+gravity = [0.0, {-grav}]
+[[bodies]]
+name = "b"
+{body}
+position = [0.0, 0.0]
+velocity = [{v * math.cos(a)!r}, {v * math.sin(a)!r}]
+{walls}""")
+
 import json
 json.dump(truth, open(os.path.join(out, "..", "truth.json"), "w"))
 EOF
@@ -492,6 +521,17 @@ for r in runs:
         if pd < 0.5 * miss - 1e-9:
             found.append(f"WRONG METRIC {sc} {eng}: ends {miss:.3g} m further from the closed form than the "
                          f"reference, position_divergence {pd:.3g}")
+for r in runs:
+    sc, eng = r["scenario"], r["engine"]
+    if not sc.startswith("box_") or r["status"] in ("unsupported", "error"):
+        continue
+    half = float(sc.split("_")[2].replace("p", "."))
+    p = r["final"][0]["position"]
+    if max(abs(p[0]), abs(p[1])) > half + 1e-9:
+        if green(r):
+            found.append(f"WRONG GREEN {sc} {eng}: ended outside its box at {p}, status {r['status']}")
+        if eng == "core":
+            found.append(f"CORE WRONG {sc}: core left its box ({p})")
 for eng, by_width in drift.items():
     base = by_width.get(1)
     for w, d in sorted(by_width.items()):
