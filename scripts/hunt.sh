@@ -18,7 +18,8 @@
 #   floorslide, settle, slope, edge   one body's closed form (friction stop, bounces to rest,
 #             held or sliding on a slope drawn three ways, sliding off a table's end): core
 #             must meet it to 1e-6 or better
-#   draglin, dragquad, thrust   the converged reference must meet the closed form
+#   kink      concave and convex kinks of a track (two walls or a surface): core to 1e-7
+#   draglin, dragquad, thrust, dragwall   the converged reference must meet the closed form
 #   every closed-form run: an engine's position_divergence must see its miss
 #   box       a point or a ball at 5-5000 m/s in a box of walls (0.3-20 m), axis, 17 deg and
 #             corners, with and without gravity: core never leaves, no engine is ok outside it
@@ -393,6 +394,103 @@ to = [0.0, 0.0]
 restitution = 0.0
 friction = {mu}
 """, [vc * s, r - 0.5 * g * s * s], [vc, -g * s], 1e-8)
+# dragwall: linear drag (and a wind) through a wall impact: the converged reference meets
+# the piecewise closed form (the impact time by bisection on it).
+def lin(x0, v0, c, acc, t):   # v' = acc - c v
+    vt = acc / c
+    return x0 + vt * t + (v0 - vt) * (1 - math.exp(-c * t)) / c, vt + (v0 - vt) * math.exp(-c * t)
+for k in [0.05, 0.5, 2.0]:
+    for e in [0.5, 1.0]:
+        for wind in [0.0, -2.0]:
+            c, r, xw = k, 0.2, 5.0
+            if lin(0.0, 8.0, c, c * wind, 5.0)[0] < xw - r:
+                continue   # the drag stops it short of the wall
+            lo, hi = 0.0, 5.0
+            for _ in range(200):
+                mid = 0.5 * (lo + hi)
+                lo, hi = (mid, hi) if lin(0.0, 8.0, c, c * wind, mid)[0] < xw - r else (lo, mid)
+            x1, vx1 = lin(0.0, 8.0, c, c * wind, hi)
+            y1, vy1 = lin(5.0, 2.0, c, -g, hi)
+            x2, vx2 = lin(x1, -e * vx1, c, c * wind, 0.5)
+            y2, vy2 = lin(y1, vy1, c, -g, 0.5)
+            n = f"dragwall_{k}_{e}_{int(-wind)}".replace(".", "p")
+            exact(n, f"""name = "{n}"
+duration = {hi + 0.5!r}
+[world]
+gravity = [0.0, -{g}]
+wind = [{wind}, 0.0]
+[[bodies]]
+name = "b"
+radius = {r}
+position = [0.0, 5.0]
+velocity = [8.0, 2.0]
+restitution = {e}
+drag_linear = {k}
+[[walls]]
+name = "wall"
+from = [{xw}, -20.0]
+to = [{xw}, 20.0]
+restitution = {e}
+""", [x2, y2], [vx2, vy2], 1e-8, "reference")
+
+# kink: a ball sliding (frictionless, e 0) into an upward ramp (concave: an impact, then up
+# the ramp at g sin) or off a floor onto a downward slope (convex, v^2 > g r: it flies off,
+# lands, slides), the track as two walls or one surface.
+for bdeg in [10, 20, 30, 45]:
+    for v0 in [1.0, 3.0]:
+        for how in ["walls", "surface"]:
+            b, r = math.radians(bdeg), 0.5
+            xc = r * (math.cos(b) - 1) / math.sin(b)
+            vt = v0 * math.cos(b)
+            s = 0.6 * vt / (g * math.sin(b))
+            d = vt * s - 0.5 * g * math.sin(b) * s * s
+            pts = [(-20.0, 0.0), (0.0, 0.0), (10 * math.cos(b), 10 * math.sin(b))]
+            if how == "walls":
+                geo = "".join(f"[[walls]]\nname = \"w{q}\"\nfrom = [{pts[q][0]!r}, {pts[q][1]!r}]\nto = [{pts[q + 1][0]!r}, {pts[q + 1][1]!r}]\nrestitution = 0.0\n" for q in range(2))
+            else:
+                geo = "[[surfaces]]\nname = \"track\"\npoints = [" + ", ".join(f"[{x!r}, {y!r}]" for x, y in pts) + "]\nrestitution = 0.0\n"
+            n = f"concave_{bdeg}_{v0}_{how}".replace(".", "p")
+            exact(n, f"""name = "{n}"
+duration = {1.0 / v0 + s!r}
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+radius = {r}
+position = [{xc - 1.0!r}, {r}]
+velocity = [{v0}, 0.0]
+restitution = 0.0
+{geo}""", [xc + d * math.cos(b), r + d * math.sin(b)],
+                  [(vt - g * math.sin(b) * s) * math.cos(b), (vt - g * math.sin(b) * s) * math.sin(b)], 1e-8)
+for bdeg in [10, 20, 30]:
+    for v0 in [2.5, 4.0]:
+        for how in ["walls", "surface"]:
+            b, r = math.radians(bdeg), 0.5
+            A, B, C = -0.5 * g * math.cos(b), math.sin(b) * v0, r * math.cos(b) - r
+            s1 = (-B - math.sqrt(B * B - 4 * A * C)) / (2 * A)
+            tdir = (math.cos(b), -math.sin(b))
+            vt = v0 * tdir[0] - g * s1 * tdir[1]
+            d = vt * 0.5 + 0.5 * g * math.sin(b) * 0.25
+            p1 = (v0 * s1, r - 0.5 * g * s1 * s1)
+            pts = [(-20.0, 0.0), (0.0, 0.0), (30 * math.cos(b), -30 * math.sin(b))]
+            if how == "walls":
+                geo = "".join(f"[[walls]]\nname = \"w{q}\"\nfrom = [{pts[q][0]!r}, {pts[q][1]!r}]\nto = [{pts[q + 1][0]!r}, {pts[q + 1][1]!r}]\nrestitution = 0.0\n" for q in range(2))
+            else:
+                geo = "[[surfaces]]\nname = \"track\"\npoints = [" + ", ".join(f"[{x!r}, {y!r}]" for x, y in pts) + "]\nrestitution = 0.0\n"
+            n = f"convex_{bdeg}_{v0}_{how}".replace(".", "p")
+            exact(n, f"""name = "{n}"
+duration = {1.0 / v0 + s1 + 0.5!r}
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+radius = {r}
+position = [-1.0, {r}]
+velocity = [{v0}, 0.0]
+restitution = 0.0
+{geo}""", [p1[0] + d * tdir[0], p1[1] + d * tdir[1]],
+                  [(vt + g * math.sin(b) * 0.5) * tdir[0], (vt + g * math.sin(b) * 0.5) * tdir[1]], 1e-7)
+
 # box: a point or a 5 cm ball at 5-5000 m/s in a box of four walls (half-width 0.3-20 m),
 # e = 1, with and without gravity, along an axis, at 17 degrees, and into the corners.
 for v in [5, 50, 200, 1000, 5000]:
