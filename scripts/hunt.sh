@@ -19,6 +19,7 @@
 #             held or sliding on a slope drawn three ways, sliding off a table's end): core
 #             must meet it to 1e-6 or better
 #   kink      concave and convex kinks of a track (two walls or a surface): core to 1e-7
+#   inclinebounce, pointsettle   a bounce with friction on a slope, a point bouncing to rest
 #   draglin, dragquad, thrust, dragwall   the converged reference must meet the closed form
 #   every closed-form run: an engine's position_divergence must see its miss
 #   box       a point or a ball at 5-5000 m/s in a box of walls (0.3-20 m), axis, 17 deg and
@@ -490,6 +491,63 @@ velocity = [{v0}, 0.0]
 restitution = 0.0
 {geo}""", [p1[0] + d * tdir[0], p1[1] + d * tdir[1]],
                   [(vt + g * math.sin(b) * 0.5) * tdir[0], (vt + g * math.sin(b) * 0.5) * tdir[1]], 1e-7)
+
+# inclinebounce: a ball or a point dropped onto a 10-50 degree slope, e 0.3-1, mu 0-0.4:
+# the impact's Newton law with Coulomb friction (the tangential change mu (1 + e) |v_n| at
+# most, or all of it), then half its next flight. pointsettle: a point bouncing to rest.
+for deg in [10, 30, 50]:
+    for e in [0.3, 0.7, 1.0]:
+        for mu in [0.0, 0.1, 0.4]:
+            for shape in ["circle", "point"]:
+                th = math.radians(deg)
+                r = 0.3 if shape == "circle" else 0.0
+                t, nn = (math.cos(th), -math.sin(th)), (math.sin(th), math.cos(th))
+                p0 = (0.0, 2.0 + r / math.cos(th))
+                t1 = math.sqrt(2 * (nn[1] * p0[1] - r) / (g * math.cos(th)))
+                vn, vt = -g * t1 * nn[1], -g * t1 * t[1]
+                dvt = 0.0 if mu == 0 else (vt if vt <= mu * (1 + e) * -vn else min(mu * (1 + e) * -vn, vt))
+                v2 = (-e * vn * nn[0] + (vt - dvt) * t[0], -e * vn * nn[1] + (vt - dvt) * t[1])
+                s = -e * vn / (g * math.cos(th))
+                body = f"radius = {r}" if shape == "circle" else 'shape = "point"'
+                n = f"inclinebounce_{deg}_{e}_{mu}_{shape}".replace(".", "p")
+                exact(n, f"""name = "{n}"
+duration = {t1 + s!r}
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+{body}
+position = [0.0, {p0[1]!r}]
+restitution = {e}
+friction = {mu}
+[[walls]]
+name = "slope"
+from = [{-40 * t[0]!r}, {-40 * t[1]!r}]
+to = [{40 * t[0]!r}, {40 * t[1]!r}]
+restitution = {e}
+friction = {mu}
+""", [v2[0] * s, p0[1] - 0.5 * g * t1 * t1 + v2[1] * s - 0.5 * g * s * s], [v2[0], v2[1] - g * s], 1e-9)
+for h in [0.3, 2.0]:
+    for e in [0.0, 0.5, 0.9]:
+        for frac in [0.5, 1.4]:
+            T = frac * math.sqrt(2 * h / g) * (1 + e) / (1 - e)
+            y, vy = bounce_state(h, e, T)
+            n = f"pointsettle_{h}_{e}_{frac}".replace(".", "p")
+            exact(n, f"""name = "{n}"
+duration = {T!r}
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+shape = "point"
+position = [0.5, {h}]
+restitution = {e}
+[[walls]]
+name = "floor"
+from = [-5.0, 0.0]
+to = [5.0, 0.0]
+restitution = {e}
+""", [0.5, y], [0.0, vy], 1e-8)
 
 # box: a point or a 5 cm ball at 5-5000 m/s in a box of four walls (half-width 0.3-20 m),
 # e = 1, with and without gravity, along an axis, at 17 degrees, and into the corners.
