@@ -1020,6 +1020,75 @@ class NearGrid {
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed_;
 };
 
+// Two bodies on faces touching with no relative normal velocity (push_trains).
+struct TrainPair {
+  std::uint32_t i, j;
+  Vec2 nrm;   // from i to j
+  double P;   // the push between them
+};
+
+// Every pair of dynamic bodies on faces (not on bodies) touching one another with no
+// relative normal velocity, pressed by their own paths or not.
+void train_pairs(const World& w, std::vector<TrainPair>& pairs) {
+  const std::size_t n = w.size();
+  thread_local std::vector<std::uint32_t> cand;
+  cand.clear();
+  pairs.clear();
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (w.dynamic(i) && w.supported(i) && !w.on_body(i)) cand.push_back(i);
+  }
+  if (cand.size() < 2) return;
+  std::sort(cand.begin(), cand.end(), [&](std::uint32_t a, std::uint32_t b) {
+    const double la = w.pos[a].x - w.radius[a], lb = w.pos[b].x - w.radius[b];
+    return la < lb || (la == lb && a < b);
+  });
+  for (std::size_t x = 0; x < cand.size(); ++x) {
+    const std::uint32_t i = cand[x];
+    const double right = w.pos[i].x + w.radius[i];
+    for (std::size_t y = x + 1; y < cand.size(); ++y) {
+      const std::uint32_t j = cand[y];
+      const double tol_reach = 1e-9 * (w.radius[i] + w.radius[j] + w.length_scale);
+      if (w.pos[j].x - w.radius[j] > right + tol_reach) break;
+      if ((w.flags[i] & kPoint) && (w.flags[j] & kPoint)) continue;
+      if (((w.flags[i] | w.flags[j]) & kParticle) && related_bodies(w, i, j)) continue;
+      if (w.any_rules && !w.response(w.group[i], w.group[j]).collide) continue;
+      const Vec2 d = w.pos[j] - w.pos[i];
+      const double dl = length(d);
+      const double R = w.radius[i] + w.radius[j];
+      if (!(dl > 0.0) || std::fabs(dl - R) > 1e-9 * (R + w.length_scale)) continue;
+      const Vec2 nrm = d / dl;
+      const double vn = dot(w.vel[j] - w.vel[i], nrm);
+      if (std::fabs(vn) > 1e-12 * (length(w.vel[i]) + length(w.vel[j]))) continue;
+      pairs.push_back({i, j, nrm, 0.0});
+    }
+  }
+}
+
+// Whether a train pair lies on one line: one face normal, the pair's normal along the face.
+bool straight_pair(const World& w, const TrainPair& p) {
+  return w.support_n[p.i] == w.support_n[p.j] && std::fabs(dot(p.nrm, perp(w.support_n[p.i]))) >= 1.0 - 1e-12;
+}
+
+// Whether body i, on its face, touches nothing but its face and bodies that are in a
+// straight train with it (`train`: members of a straight pair): push_trains judges it
+// with them, as one rigid block, held or sliding.
+bool only_in_train(World& w, std::uint32_t i, std::span<const std::uint32_t> near, const std::vector<char>& train) {
+  if (!train[i]) return false;
+  thread_local std::vector<HeldContact> contacts;
+  thread_local std::vector<double> mu;
+  contacts.clear();
+  mu.clear();
+  touching_supports(w, i, near, contacts, mu);
+  for (const HeldContact& c : contacts) {
+    if (c.other & kBodySupport) {
+      if ((c.other & ~kBodySupport) != w.support[i]) return false;   // a second face
+    } else if (!(w.dynamic(c.other) && w.supported(c.other) && !w.on_body(c.other) && train[c.other])) {
+      return false;   // a held body, a body on a body, a static one
+    }
+  }
+  return true;
+}
+
 std::uint32_t held_partner_key(const World& w, const HeldContact& c) {
   return (c.other & kBodySupport) ? static_partner_key(w.statics.segments[c.other & ~kBodySupport].owner) : c.other;
 }
@@ -1060,6 +1129,18 @@ bool hold_pass(World& w, const StepContext& ctx) {
     for (std::uint32_t d : w.released) release_support(w, d);
   }
   if (changed) grid.build(w, std::max(2.0 * rmax, 1e-6 * w.length_scale) * (1.0 + 1e-6));
+  // Bodies in a straight train on a face: judged together by push_trains, not one by one.
+  thread_local std::vector<char> train;
+  thread_local std::vector<TrainPair> train_pair_list;
+  train.clear();
+  if (!w.varying_forces) {
+    train_pairs(w, train_pair_list);
+    for (const TrainPair& p : train_pair_list) {
+      if (!straight_pair(w, p)) continue;
+      if (train.empty()) train.assign(n, 0);
+      train[p.i] = train[p.j] = 1;
+    }
+  }
   for (std::uint32_t i = 0; i < n; ++i) {
     if (!w.dynamic(i)) continue;
     // Free, or at rest on its face and driven along it (the face alone cannot hold it: a
@@ -1068,6 +1149,7 @@ bool hold_pass(World& w, const StepContext& ctx) {
                         (w.apath[i].x != 0.0 || w.apath[i].y != 0.0);
     if (w.supported(i) && !driven) continue;
     grid.query(w.pos[i], near);
+    if (driven && !train.empty() && only_in_train(w, i, near, train)) continue;   // push_trains
     group.clear();
     if (try_hold(w, i, ctx.dt, near)) {
       group.push_back(i);
@@ -1103,58 +1185,32 @@ bool hold_pass(World& w, const StepContext& ctx) {
   return changed;
 }
 
-// Bodies on faces pressed together while they slide (a ball pushing another down a
-// slope, the lower one's friction too much for the upper alone and too little for both):
-// rigid bodies in contact move together, so each member feels its neighbours' push as a
-// force. The pair forces P_k >= 0 (along each pair's normal; no friction between them)
-// are solved by Gauss-Seidel so that no pressed pair's relative acceleration along its
-// normal stays negative, each member's acceleration being its face's law
-// (support_acceleration: kinetic friction sliding, static from rest) under its own force
-// plus the pushes; the pushes are then added to the members' force accelerations for
-// the step and their paths recomputed, so every later event of the step (a stop, a hold)
-// sees them. Pairs are those touching, with no relative normal velocity, pressed by their
-// own paths. Constant forces only (under drag a face's law is integrated in sub-steps).
+// Bodies on faces touching one another while they slide or rest (a ball pushing another
+// down a slope, the lower one's friction too much for the upper alone and too little for
+// both): rigid bodies in contact move together, so each member feels its neighbours' push
+// as a force. The pairs are all those touching on faces with no relative normal velocity,
+// whether or not their own paths press them (two balls sliding alike behind a slower one
+// are pressed only once the front one's push slows the middle one). The pair forces
+// P_k >= 0 (along each pair's normal; no friction between them) solve the linear
+// complementarity problem P_k >= 0, relative normal acceleration w_k >= 0, P_k w_k = 0,
+// each member's acceleration being its face's law (support_acceleration: kinetic friction
+// sliding, static from rest) under its own force plus the pushes: projected Gauss-Seidel
+// finds it, a pair that separates keeps P = 0. A train of bodies on one line (one face
+// normal, every pressed pair's normal along the face) is then a rigid block: its
+// acceleration is its face's law for the block's total force, mass and friction, summed
+// in the order along the face (so the same bits whatever the numbering), and every member
+// gets that acceleration and the block's velocity to the bit (else round-off reads as an
+// approach and the touching pair is met as an impact at once). The pushes are added to
+// the members' force accelerations for the step and their paths recomputed, so every
+// later event of the step (a stop, a hold) sees them. Constant forces only (under drag a
+// face's law is integrated in sub-steps).
 void push_trains(World& w) {
   const std::size_t n = w.size();
-  thread_local std::vector<std::uint32_t> cand, parent;
+  thread_local std::vector<std::uint32_t> root, block;
   thread_local std::vector<Vec2> push;
-  struct Pair {
-    std::uint32_t i, j;
-    Vec2 nrm;   // from i to j
-    double P;
-  };
-  thread_local std::vector<Pair> pairs;
-  cand.clear();
-  pairs.clear();
-  for (std::uint32_t i = 0; i < n; ++i) {
-    if (w.dynamic(i) && w.supported(i) && !w.on_body(i)) cand.push_back(i);
-  }
-  if (cand.size() < 2) return;
-  std::sort(cand.begin(), cand.end(), [&](std::uint32_t a, std::uint32_t b) {
-    const double la = w.pos[a].x - w.radius[a], lb = w.pos[b].x - w.radius[b];
-    return la < lb || (la == lb && a < b);
-  });
-  for (std::size_t x = 0; x < cand.size(); ++x) {
-    const std::uint32_t i = cand[x];
-    const double right = w.pos[i].x + w.radius[i];
-    for (std::size_t y = x + 1; y < cand.size(); ++y) {
-      const std::uint32_t j = cand[y];
-      const double tol_reach = 1e-9 * (w.radius[i] + w.radius[j] + w.length_scale);
-      if (w.pos[j].x - w.radius[j] > right + tol_reach) break;
-      if ((w.flags[i] & kPoint) && (w.flags[j] & kPoint)) continue;
-      if (((w.flags[i] | w.flags[j]) & kParticle) && related_bodies(w, i, j)) continue;
-      if (w.any_rules && !w.response(w.group[i], w.group[j]).collide) continue;
-      const Vec2 d = w.pos[j] - w.pos[i];
-      const double dl = length(d);
-      const double R = w.radius[i] + w.radius[j];
-      if (!(dl > 0.0) || std::fabs(dl - R) > 1e-9 * (R + w.length_scale)) continue;
-      const Vec2 nrm = d / dl;
-      const double vn = dot(w.vel[j] - w.vel[i], nrm);
-      if (std::fabs(vn) > 1e-12 * (length(w.vel[i]) + length(w.vel[j]))) continue;
-      if (!(dot(w.apath[j] - w.apath[i], nrm) < 0.0)) continue;   // not pressed
-      pairs.push_back({i, j, nrm, 0.0});
-    }
-  }
+  thread_local std::vector<char> bent;
+  thread_local std::vector<TrainPair> pairs;
+  train_pairs(w, pairs);
   if (pairs.empty()) return;
   push.assign(n, Vec2{});
   const auto acc_of = [&](std::uint32_t m) {
@@ -1162,10 +1218,11 @@ void push_trains(World& w) {
     return support_acceleration(w, m, w.acc[m] + push[m], dot(w.vel[m], t));
   };
   double amax = 0.0;
-  for (const Pair& p : pairs) amax = std::max({amax, length(w.acc[p.i]), length(w.acc[p.j])});
+  for (const TrainPair& p : pairs) amax = std::max({amax, length(w.acc[p.i]), length(w.acc[p.j])});
+  bool pressed = false;
   for (int iter = 0; iter < 100000; ++iter) {
     double change = 0.0;
-    for (Pair& p : pairs) {
+    for (TrainPair& p : pairs) {
       const double wk = dot(acc_of(p.j) - acc_of(p.i), p.nrm);
       const double ti = dot(perp(w.support_n[p.i]), p.nrm), tj = dot(perp(w.support_n[p.j]), p.nrm);
       const double K = ti * ti * w.inv_mass[p.i] + tj * tj * w.inv_mass[p.j];
@@ -1174,29 +1231,108 @@ void push_trains(World& w) {
       const double dP = P - p.P;
       if (dP == 0.0) continue;
       p.P = P;
+      pressed = true;
       push[p.i] -= (dP * w.inv_mass[p.i]) * p.nrm;
       push[p.j] += (dP * w.inv_mass[p.j]) * p.nrm;
       change = std::max(change, std::fabs(dP) * K);
     }
     if (change <= 1e-15 * amax) break;
   }
-  for (const Pair& p : pairs) {
+  if (!pressed) {   // nothing pushes: only make bodies sliding alike alike to the bit
+    push.clear();
+  }
+  // Blocks: bodies joined by pressed pairs (union-find over the pair members).
+  root.resize(n);
+  bent.assign(n, 0);
+  for (const TrainPair& p : pairs) root[p.i] = p.i, root[p.j] = p.j;
+  const auto find = [&](std::uint32_t m) {
+    while (root[m] != m) m = root[m] = root[root[m]];
+    return m;
+  };
+  for (const TrainPair& p : pairs) {
+    if (p.P > 0.0) root[find(p.i)] = find(p.j);
+  }
+  for (const TrainPair& p : pairs) {
+    if (!(p.P > 0.0)) continue;
+    if (!straight_pair(w, p)) bent[find(p.i)] = 1;
+  }
+  // A straight block (every member on one line): the face's law for the whole block.
+  block.clear();
+  for (const TrainPair& p : pairs) {
+    if (!(p.P > 0.0)) continue;
     for (std::uint32_t m : {p.i, p.j}) {
-      if (push[m].x == 0.0 && push[m].y == 0.0) continue;
+      if (!bent[find(m)]) block.push_back(m);
+    }
+  }
+  std::sort(block.begin(), block.end());
+  block.erase(std::unique(block.begin(), block.end()), block.end());
+  std::stable_sort(block.begin(), block.end(), [&](std::uint32_t a, std::uint32_t b) {
+    const std::uint32_t ra = find(a), rb = find(b);
+    if (ra != rb) return ra < rb;
+    const Vec2 t = perp(w.support_n[a]);
+    return dot(w.pos[a], t) < dot(w.pos[b], t);
+  });
+  thread_local std::vector<char> in_block;
+  in_block.assign(n, 0);
+  for (std::size_t b = 0; b < block.size();) {
+    std::size_t e = b;
+    while (e < block.size() && find(block[e]) == find(block[b])) ++e;
+    const Vec2 nn = w.support_n[block[b]], tt = perp(nn);
+    const double v = dot(w.vel[block[b]], tt);   // the first member's along the face (all agree to round-off)
+    double M = 0.0, F = 0.0, H = 0.0, Kin = 0.0;
+    for (std::size_t x = b; x < e; ++x) {
+      const std::uint32_t m = block[x];
+      const Coefficients c = coefficients(w, m, w.statics.segments[w.support[m]]);
+      const double mass = 1.0 / w.inv_mass[m];
+      const double N = mass * std::max(-dot(w.acc[m], nn), 0.0);
+      M += mass;
+      F += mass * dot(w.acc[m], tt);
+      H += c.holding * N;
+      Kin += c.moving * N;
+    }
+    double a;
+    if (v == 0.0) {
+      a = std::fabs(F) <= H ? 0.0 : (F - std::copysign(Kin, F)) / M;
+    } else {
+      a = (F - std::copysign(Kin, v)) / M;
+    }
+    for (std::size_t x = b; x < e; ++x) {
+      const std::uint32_t m = block[x];
+      in_block[m] = 1;
+      if (!(v == 0.0 && a == 0.0)) {   // sliding: the push that gives it the block's a
+        const Coefficients c = coefficients(w, m, w.statics.segments[w.support[m]]);
+        const double N = std::max(-dot(w.acc[m], nn), 0.0);
+        const double own = dot(w.acc[m], tt) - std::copysign(c.moving * N, v != 0.0 ? v : F);
+        push[m] = (a - own) * tt;
+      }   // at rest and held: the static pushes found above
+      w.acc[m] += push[m];
+      push[m] = {};
+      w.vel[m] = v * tt;
+      support_path(w, m);
+      w.vel[m] = v * tt;
+      w.apath[m] = a * tt;
+    }
+    b = e;
+  }
+  for (const TrainPair& p : pairs) {
+    for (std::uint32_t m : {p.i, p.j}) {
+      if (push.empty() || (push[m].x == 0.0 && push[m].y == 0.0)) continue;
       w.acc[m] += push[m];
       push[m] = {};
       support_path(w, m);
     }
   }
-  // A pair on one line moves as one: the same velocity and acceleration to the bit (else
-  // round-off reads as an approach and the touching pair is met as an impact at once).
-  for (const Pair& p : pairs) {
-    if (w.support_n[p.i] != w.support_n[p.j]) continue;
+  // Pairs on one line that move alike (sliding alike, unpressed, or in a bent train) move
+  // as one: the same velocity and acceleration to the bit, a block's taken over by a
+  // body that is in none.
+  for (const TrainPair& p : pairs) {
+    if (w.support_n[p.i] != w.support_n[p.j] || (in_block[p.i] && in_block[p.j])) continue;
     const Vec2 dv = w.vel[p.j] - w.vel[p.i], da = w.apath[p.j] - w.apath[p.i];
     const double vs = length(w.vel[p.i]) + length(w.vel[p.j]), as = length(w.apath[p.i]) + length(w.apath[p.j]);
     if (length(dv) > 1e-12 * vs || length(da) > 1e-12 * as) continue;
-    w.vel[p.j] = w.vel[p.i];
-    w.apath[p.j] = w.apath[p.i];
+    const std::uint32_t from = in_block[p.j] ? p.j : p.i, to = from == p.i ? p.j : p.i;
+    w.vel[to] = w.vel[from];
+    w.apath[to] = w.apath[from];
   }
 }
 
