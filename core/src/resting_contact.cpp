@@ -1129,18 +1129,26 @@ bool hold_pass(World& w, const StepContext& ctx) {
     for (std::uint32_t d : w.released) release_support(w, d);
   }
   if (changed) grid.build(w, std::max(2.0 * rmax, 1e-6 * w.length_scale) * (1.0 + 1e-6));
-  // Bodies in a straight train on a face: judged together by push_trains, not one by one.
+  // Bodies in a straight train on a face: judged together by push_trains, not one by one
+  // (found at the first driven body).
   thread_local std::vector<char> train;
   thread_local std::vector<TrainPair> train_pair_list;
   train.clear();
-  if (!w.varying_forces) {
-    train_pairs(w, train_pair_list);
-    for (const TrainPair& p : train_pair_list) {
-      if (!straight_pair(w, p)) continue;
-      if (train.empty()) train.assign(n, 0);
-      train[p.i] = train[p.j] = 1;
+  bool trains_found = w.varying_forces;
+  const auto in_a_train = [&](std::uint32_t i) {
+    if (!trains_found) {
+      trains_found = true;
+      train_pairs(w, train_pair_list);
+      for (const TrainPair& p : train_pair_list) {
+        if (!straight_pair(w, p)) continue;
+        if (train.empty()) train.assign(n, 0);
+        train[p.i] = train[p.j] = 1;
+      }
     }
-  }
+    if (train.empty()) return false;
+    grid.query(w.pos[i], near);
+    return only_in_train(w, i, near, train);
+  };
   for (std::uint32_t i = 0; i < n; ++i) {
     if (!w.dynamic(i)) continue;
     // Free, or at rest on its face and driven along it (the face alone cannot hold it: a
@@ -1148,8 +1156,8 @@ bool hold_pass(World& w, const StepContext& ctx) {
     const bool driven = w.supported(i) && !w.on_body(i) && w.vel[i] == Vec2{} &&
                         (w.apath[i].x != 0.0 || w.apath[i].y != 0.0);
     if (w.supported(i) && !driven) continue;
+    if (driven && in_a_train(i)) continue;   // push_trains judges it
     grid.query(w.pos[i], near);
-    if (driven && !train.empty() && only_in_train(w, i, near, train)) continue;   // push_trains
     group.clear();
     if (try_hold(w, i, ctx.dt, near)) {
       group.push_back(i);
@@ -1206,23 +1214,138 @@ bool hold_pass(World& w, const StepContext& ctx) {
 // face's law is integrated in sub-steps).
 void push_trains(World& w) {
   const std::size_t n = w.size();
-  thread_local std::vector<std::uint32_t> root, block;
+  thread_local std::vector<std::uint32_t> root, members, order;
   thread_local std::vector<Vec2> push;
-  thread_local std::vector<char> bent;
+  thread_local std::vector<char> mixed, in_block;
   thread_local std::vector<TrainPair> pairs;
   train_pairs(w, pairs);
   if (pairs.empty()) return;
+  root.resize(n);
+  mixed.assign(n, 0);
+  in_block.assign(n, 0);
   push.assign(n, Vec2{});
+  for (const TrainPair& p : pairs) root[p.i] = p.i, root[p.j] = p.j;
+  const auto find = [&](std::uint32_t m) {
+    while (root[m] != m) m = root[m] = root[root[m]];
+    return m;
+  };
+  // The face's law for a rigid block: members (sorted along the face, so the sums are the
+  // same bits whatever the numbering) all move at the block's velocity v (the first
+  // member's: they agree to round-off) and acceleration a.
+  struct Law {
+    double M = 0.0, F = 0.0, H = 0.0, K = 0.0;
+  };
+  const auto law_of = [&](std::uint32_t m) {
+    const Vec2 nn = w.support_n[m], tt = perp(nn);
+    const Coefficients c = coefficients(w, m, w.statics.segments[w.support[m]]);
+    const double mass = 1.0 / w.inv_mass[m];
+    const double N = mass * std::max(-dot(w.acc[m], nn), 0.0);
+    return Law{mass, mass * dot(w.acc[m], tt), c.holding * N, c.moving * N};
+  };
+  const auto block_a = [](const Law& L, double v) {
+    if (v == 0.0) return std::fabs(L.F) <= L.H ? 0.0 : (L.F - std::copysign(L.K, L.F)) / L.M;
+    return (L.F - std::copysign(L.K, v)) / L.M;
+  };
+  // static_push: at rest and held, whether the pushes found by the pair solver (below) are
+  // the members' (else each member's friction takes its share of the block's force, in
+  // proportion to what it can hold).
+  const auto set_block = [&](std::span<const std::uint32_t> blk, const Law& L, double v, double a, bool static_push) {
+    const Vec2 tt = perp(w.support_n[blk[0]]);
+    for (std::uint32_t m : blk) {
+      const Law own = law_of(m);
+      if (v != 0.0 || a != 0.0) {   // sliding: the push that gives it the block's a
+        const double own_a = (own.F - std::copysign(own.K, v != 0.0 ? v : L.F)) / own.M;
+        push[m] = (a - own_a) * tt;
+      } else if (!static_push) {
+        const double share = L.H > 0.0 ? L.F * (own.H / L.H) : 0.0;
+        push[m] = ((share - own.F) / own.M) * tt;
+      }
+      if (blk.size() > 1) in_block[m] = 1;
+      w.acc[m] += push[m];
+      push[m] = {};
+      w.vel[m] = v * tt;
+      support_path(w, m);
+      w.vel[m] = v * tt;
+      w.apath[m] = a * tt;
+    }
+  };
+  const auto along = [&](std::uint32_t a, std::uint32_t b) {
+    const std::uint32_t ra = find(a), rb = find(b);
+    if (ra != rb) return ra < rb;
+    const Vec2 t = perp(w.support_n[a]);
+    return dot(w.pos[a], t) < dot(w.pos[b], t);
+  };
+  const auto gather = [&](auto&& keep) {   // members of kept pairs, by component, along the face
+    members.clear();
+    for (const TrainPair& p : pairs) {
+      if (keep(p)) members.push_back(p.i), members.push_back(p.j);
+    }
+    std::sort(members.begin(), members.end());
+    members.erase(std::unique(members.begin(), members.end()), members.end());
+    std::stable_sort(members.begin(), members.end(), along);
+  };
+
+  // Straight chains (bodies on one line, touching only one another there): exact, by
+  // pooling from the rear: a block behind that would accelerate faster along the face
+  // than the block in front presses it and joins it (the rigid Coulomb solution of the
+  // complementarity problem; a tie to round-off joins too, so the pair keeps the same bits).
+  for (const TrainPair& p : pairs) {
+    if (straight_pair(w, p)) root[find(p.i)] = find(p.j);
+  }
+  for (const TrainPair& p : pairs) {
+    if (!straight_pair(w, p) || !(w.inv_mass[p.i] > 0.0) || !(w.inv_mass[p.j] > 0.0)) {
+      mixed[find(p.i)] = mixed[find(p.j)] = 1;
+    }
+  }
+  gather([&](const TrainPair& p) { return !mixed[find(p.i)]; });
+  struct Pool {
+    std::size_t b, e;
+    Law L;
+    double a;
+  };
+  thread_local std::vector<Pool> pools;
+  for (std::size_t b = 0; b < members.size();) {
+    std::size_t e = b;
+    while (e < members.size() && find(members[e]) == find(members[b])) ++e;
+    const Vec2 tt = perp(w.support_n[members[b]]);
+    const double v = dot(w.vel[members[b]], tt);
+    pools.clear();
+    for (std::size_t x = b; x < e; ++x) {
+      const Law L = law_of(members[x]);
+      pools.push_back({x, x + 1, L, block_a(L, v)});
+      while (pools.size() > 1) {
+        const Pool& back = pools[pools.size() - 2];
+        const Pool& front = pools.back();
+        if (!(back.a - front.a > -1e-12 * (std::fabs(back.a) + std::fabs(front.a)))) break;
+        Pool joined{back.b, front.e, {back.L.M + front.L.M, back.L.F + front.L.F, back.L.H + front.L.H, back.L.K + front.L.K}, 0.0};
+        joined.a = block_a(joined.L, v);
+        pools.pop_back();
+        pools.back() = joined;
+      }
+    }
+    for (const Pool& q : pools) {
+      set_block(std::span<const std::uint32_t>(members).subspan(q.b, q.e - q.b), q.L, v, q.a, false);
+    }
+    b = e;
+  }
+
+  // Everything else (bodies of other sizes, on other faces): the pair forces P_k >= 0 by
+  // projected Gauss-Seidel, pairs that separate keeping P = 0; a pressed straight run in
+  // it is then a rigid block as above.
+  bool pressed = false;
+  const auto gs_pair = [&](const TrainPair& p) { return mixed[find(p.i)] != 0; };
   const auto acc_of = [&](std::uint32_t m) {
     const Vec2 t = perp(w.support_n[m]);
     return support_acceleration(w, m, w.acc[m] + push[m], dot(w.vel[m], t));
   };
   double amax = 0.0;
-  for (const TrainPair& p : pairs) amax = std::max({amax, length(w.acc[p.i]), length(w.acc[p.j])});
-  bool pressed = false;
-  for (int iter = 0; iter < 100000; ++iter) {
+  for (const TrainPair& p : pairs) {
+    if (gs_pair(p)) amax = std::max({amax, length(w.acc[p.i]), length(w.acc[p.j])});
+  }
+  for (int iter = 0; amax > 0.0 && iter < 100000; ++iter) {
     double change = 0.0;
     for (TrainPair& p : pairs) {
+      if (!gs_pair(p)) continue;
       const double wk = dot(acc_of(p.j) - acc_of(p.i), p.nrm);
       const double ti = dot(perp(w.support_n[p.i]), p.nrm), tj = dot(perp(w.support_n[p.j]), p.nrm);
       const double K = ti * ti * w.inv_mass[p.i] + tj * tj * w.inv_mass[p.j];
@@ -1238,92 +1361,47 @@ void push_trains(World& w) {
     }
     if (change <= 1e-15 * amax) break;
   }
-  if (!pressed) {   // nothing pushes: only make bodies sliding alike alike to the bit
-    push.clear();
-  }
-  // Blocks: bodies joined by pressed pairs (union-find over the pair members).
-  root.resize(n);
-  bent.assign(n, 0);
-  for (const TrainPair& p : pairs) root[p.i] = p.i, root[p.j] = p.j;
-  const auto find = [&](std::uint32_t m) {
-    while (root[m] != m) m = root[m] = root[root[m]];
-    return m;
-  };
-  for (const TrainPair& p : pairs) {
-    if (p.P > 0.0) root[find(p.i)] = find(p.j);
-  }
-  for (const TrainPair& p : pairs) {
-    if (!(p.P > 0.0)) continue;
-    if (!straight_pair(w, p)) bent[find(p.i)] = 1;
-  }
-  // A straight block (every member on one line): the face's law for the whole block.
-  block.clear();
-  for (const TrainPair& p : pairs) {
-    if (!(p.P > 0.0)) continue;
-    for (std::uint32_t m : {p.i, p.j}) {
-      if (!bent[find(m)]) block.push_back(m);
+  if (pressed) {
+    // Pressed straight runs: union-find again, over the pressed straight pairs only.
+    for (const TrainPair& p : pairs) {
+      if (gs_pair(p)) root[p.i] = p.i, root[p.j] = p.j;
+    }
+    for (const TrainPair& p : pairs) {
+      if (gs_pair(p) && p.P > 0.0 && straight_pair(w, p)) root[find(p.i)] = find(p.j);
+    }
+    gather([&](const TrainPair& p) { return gs_pair(p) && p.P > 0.0 && straight_pair(w, p); });
+    for (const TrainPair& p : pairs) {   // a member pressed off the line too is not a block's
+      if (gs_pair(p) && p.P > 0.0 && !straight_pair(w, p)) mixed[p.i] = mixed[p.j] = 2;
+    }
+    for (std::size_t b = 0; b < members.size();) {
+      std::size_t e = b;
+      bool off_line = false;
+      while (e < members.size() && find(members[e]) == find(members[b])) off_line |= mixed[members[e++]] == 2;
+      if (!off_line) {
+        const Vec2 tt = perp(w.support_n[members[b]]);
+        const double v = dot(w.vel[members[b]], tt);
+        Law L;
+        for (std::size_t x = b; x < e; ++x) {
+          const Law o = law_of(members[x]);
+          L = {L.M + o.M, L.F + o.F, L.H + o.H, L.K + o.K};
+        }
+        set_block(std::span<const std::uint32_t>(members).subspan(b, e - b), L, v, block_a(L, v), true);
+      }
+      b = e;
+    }
+    for (const TrainPair& p : pairs) {
+      if (!gs_pair(p)) continue;
+      for (std::uint32_t m : {p.i, p.j}) {
+        if (push[m].x == 0.0 && push[m].y == 0.0) continue;
+        w.acc[m] += push[m];
+        push[m] = {};
+        support_path(w, m);
+      }
     }
   }
-  std::sort(block.begin(), block.end());
-  block.erase(std::unique(block.begin(), block.end()), block.end());
-  std::stable_sort(block.begin(), block.end(), [&](std::uint32_t a, std::uint32_t b) {
-    const std::uint32_t ra = find(a), rb = find(b);
-    if (ra != rb) return ra < rb;
-    const Vec2 t = perp(w.support_n[a]);
-    return dot(w.pos[a], t) < dot(w.pos[b], t);
-  });
-  thread_local std::vector<char> in_block;
-  in_block.assign(n, 0);
-  for (std::size_t b = 0; b < block.size();) {
-    std::size_t e = b;
-    while (e < block.size() && find(block[e]) == find(block[b])) ++e;
-    const Vec2 nn = w.support_n[block[b]], tt = perp(nn);
-    const double v = dot(w.vel[block[b]], tt);   // the first member's along the face (all agree to round-off)
-    double M = 0.0, F = 0.0, H = 0.0, Kin = 0.0;
-    for (std::size_t x = b; x < e; ++x) {
-      const std::uint32_t m = block[x];
-      const Coefficients c = coefficients(w, m, w.statics.segments[w.support[m]]);
-      const double mass = 1.0 / w.inv_mass[m];
-      const double N = mass * std::max(-dot(w.acc[m], nn), 0.0);
-      M += mass;
-      F += mass * dot(w.acc[m], tt);
-      H += c.holding * N;
-      Kin += c.moving * N;
-    }
-    double a;
-    if (v == 0.0) {
-      a = std::fabs(F) <= H ? 0.0 : (F - std::copysign(Kin, F)) / M;
-    } else {
-      a = (F - std::copysign(Kin, v)) / M;
-    }
-    for (std::size_t x = b; x < e; ++x) {
-      const std::uint32_t m = block[x];
-      in_block[m] = 1;
-      if (!(v == 0.0 && a == 0.0)) {   // sliding: the push that gives it the block's a
-        const Coefficients c = coefficients(w, m, w.statics.segments[w.support[m]]);
-        const double N = std::max(-dot(w.acc[m], nn), 0.0);
-        const double own = dot(w.acc[m], tt) - std::copysign(c.moving * N, v != 0.0 ? v : F);
-        push[m] = (a - own) * tt;
-      }   // at rest and held: the static pushes found above
-      w.acc[m] += push[m];
-      push[m] = {};
-      w.vel[m] = v * tt;
-      support_path(w, m);
-      w.vel[m] = v * tt;
-      w.apath[m] = a * tt;
-    }
-    b = e;
-  }
-  for (const TrainPair& p : pairs) {
-    for (std::uint32_t m : {p.i, p.j}) {
-      if (push.empty() || (push[m].x == 0.0 && push[m].y == 0.0)) continue;
-      w.acc[m] += push[m];
-      push[m] = {};
-      support_path(w, m);
-    }
-  }
-  // Pairs on one line that move alike (sliding alike, unpressed, or in a bent train) move
-  // as one: the same velocity and acceleration to the bit, a block's taken over by a
+  // Pairs on one line that move alike (sliding alike, unpressed, or pushed off the line)
+  // move as one: the same velocity and acceleration to the bit (else round-off reads as an
+  // approach and the touching pair is met as an impact at once), a block's taken over by a
   // body that is in none.
   for (const TrainPair& p : pairs) {
     if (w.support_n[p.i] != w.support_n[p.j] || (in_block[p.i] && in_block[p.j])) continue;
