@@ -55,6 +55,27 @@ void support_path(World& w, std::uint32_t i) {
   w.apath[i] = support_acceleration(w, i, w.acc[i], vt);
 }
 
+void stopping_mates(const World& w, std::uint32_t i, std::vector<std::uint32_t>& out) {
+  out.clear();
+  if (std::find(w.train_stopping.begin(), w.train_stopping.end(), i) == w.train_stopping.end()) return;
+  for (std::uint32_t m : w.train_stopping) {
+    if (m != i && w.train_block[m] == w.train_block[i]) out.push_back(m);
+  }
+}
+
+void stop_on_support(World& w, std::uint32_t i) {
+  w.vel[i] = {};
+  const auto it = std::find(w.train_stopping.begin(), w.train_stopping.end(), i);
+  if (it == w.train_stopping.end()) {
+    support_path(w, i);
+    return;
+  }
+  w.train_stopping.erase(it);
+  w.acc[i] = w.train_stop_acc[i];
+  support_path(w, i);
+  w.apath[i] = w.train_stop_apath[i];
+}
+
 Vec2 support_acceleration(const World& w, std::uint32_t i, Vec2 a, double vt) {
   const Segment& s = w.statics.segments[w.support[i]];
   const Vec2 n = w.support_n[i];
@@ -1218,6 +1239,7 @@ void push_trains(World& w) {
   thread_local std::vector<Vec2> push;
   thread_local std::vector<char> mixed, in_block;
   thread_local std::vector<TrainPair> pairs;
+  w.train_stopping.clear();
   train_pairs(w, pairs);
   if (pairs.empty()) return;
   root.resize(n);
@@ -1246,20 +1268,64 @@ void push_trains(World& w) {
     if (v == 0.0) return std::fabs(L.F) <= L.H ? 0.0 : (L.F - std::copysign(L.K, L.F)) / L.M;
     return (L.F - std::copysign(L.K, v)) / L.M;
   };
-  // static_push: at rest and held, whether the pushes found by the pair solver (below) are
-  // the members' (else each member's friction takes its share of the block's force, in
-  // proportion to what it can hold).
+  // The push (per mass) giving member m the block's a: sliding, the difference to its own
+  // law; at rest and held (a == 0), each member's friction taking its share of the block's
+  // force in proportion to what it can hold.
+  const auto push_for = [&](std::uint32_t m, const Law& L, double v, double a) {
+    const Vec2 tt = perp(w.support_n[m]);
+    const Law own = law_of(m);
+    if (v != 0.0 || a != 0.0) {
+      const double own_a = (own.F - std::copysign(own.K, v != 0.0 ? v : L.F)) / own.M;
+      return (a - own_a) * tt;
+    }
+    const double share = L.H > 0.0 ? L.F * (own.H / L.H) : 0.0;
+    return ((share - own.F) / own.M) * tt;
+  };
+  // Pooling a chain (sorted along the face, all at velocity v) from the rear: a block behind
+  // that would accelerate faster along the face than the block in front presses it and
+  // joins it (a tie to round-off joins too, so the pair keeps the same bits).
+  struct Pool {
+    std::size_t b, e;
+    Law L;
+    double a;
+  };
+  const auto pool = [&](std::span<const std::uint32_t> chain, double v, std::vector<Pool>& pools) {
+    pools.clear();
+    for (std::size_t x = 0; x < chain.size(); ++x) {
+      const Law L = law_of(chain[x]);
+      pools.push_back({x, x + 1, L, block_a(L, v)});
+      while (pools.size() > 1) {
+        const Pool& back = pools[pools.size() - 2];
+        const Pool& front = pools.back();
+        if (!(back.a - front.a > -1e-12 * (std::fabs(back.a) + std::fabs(front.a)))) break;
+        Pool joined{back.b, front.e, {back.L.M + front.L.M, back.L.F + front.L.F, back.L.H + front.L.H, back.L.K + front.L.K}, 0.0};
+        joined.a = block_a(joined.L, v);
+        pools.pop_back();
+        pools.back() = joined;
+      }
+    }
+  };
+  thread_local std::vector<Pool> rest_pools;
+  // Members of a block get its velocity and acceleration to the bit. static_push: at rest and
+  // held, keep the pushes the pair solver found (below). A block sliding to a stop also gets
+  // its path from rest (pooled again at v = 0) for its members' stop events.
   const auto set_block = [&](std::span<const std::uint32_t> blk, const Law& L, double v, double a, bool static_push) {
     const Vec2 tt = perp(w.support_n[blk[0]]);
-    for (std::uint32_t m : blk) {
-      const Law own = law_of(m);
-      if (v != 0.0 || a != 0.0) {   // sliding: the push that gives it the block's a
-        const double own_a = (own.F - std::copysign(own.K, v != 0.0 ? v : L.F)) / own.M;
-        push[m] = (a - own_a) * tt;
-      } else if (!static_push) {
-        const double share = L.H > 0.0 ? L.F * (own.H / L.H) : 0.0;
-        push[m] = ((share - own.F) / own.M) * tt;
+    if (blk.size() > 1 && v != 0.0 && a != 0.0 && (a > 0.0) != (v > 0.0)) {
+      if (w.train_stop_acc.size() < n) w.train_stop_acc.resize(n), w.train_stop_apath.resize(n), w.train_block.resize(n);
+      pool(blk, 0.0, rest_pools);
+      for (const Pool& q : rest_pools) {
+        for (std::size_t x = q.b; x < q.e; ++x) {
+          const std::uint32_t m = blk[x];
+          w.train_stop_acc[m] = w.acc[m] + push_for(m, q.L, 0.0, q.a);
+          w.train_stop_apath[m] = q.a * tt;
+          w.train_block[m] = blk[0];
+          w.train_stopping.push_back(m);
+        }
       }
+    }
+    for (std::uint32_t m : blk) {
+      if (!(v == 0.0 && a == 0.0 && static_push)) push[m] = push_for(m, L, v, a);
       if (blk.size() > 1) in_block[m] = 1;
       w.acc[m] += push[m];
       push[m] = {};
@@ -1298,34 +1364,15 @@ void push_trains(World& w) {
     }
   }
   gather([&](const TrainPair& p) { return !mixed[find(p.i)]; });
-  struct Pool {
-    std::size_t b, e;
-    Law L;
-    double a;
-  };
   thread_local std::vector<Pool> pools;
   for (std::size_t b = 0; b < members.size();) {
     std::size_t e = b;
     while (e < members.size() && find(members[e]) == find(members[b])) ++e;
     const Vec2 tt = perp(w.support_n[members[b]]);
     const double v = dot(w.vel[members[b]], tt);
-    pools.clear();
-    for (std::size_t x = b; x < e; ++x) {
-      const Law L = law_of(members[x]);
-      pools.push_back({x, x + 1, L, block_a(L, v)});
-      while (pools.size() > 1) {
-        const Pool& back = pools[pools.size() - 2];
-        const Pool& front = pools.back();
-        if (!(back.a - front.a > -1e-12 * (std::fabs(back.a) + std::fabs(front.a)))) break;
-        Pool joined{back.b, front.e, {back.L.M + front.L.M, back.L.F + front.L.F, back.L.H + front.L.H, back.L.K + front.L.K}, 0.0};
-        joined.a = block_a(joined.L, v);
-        pools.pop_back();
-        pools.back() = joined;
-      }
-    }
-    for (const Pool& q : pools) {
-      set_block(std::span<const std::uint32_t>(members).subspan(q.b, q.e - q.b), q.L, v, q.a, false);
-    }
+    const std::span<const std::uint32_t> chain = std::span<const std::uint32_t>(members).subspan(b, e - b);
+    pool(chain, v, pools);
+    for (const Pool& q : pools) set_block(chain.subspan(q.b, q.e - q.b), q.L, v, q.a, false);
     b = e;
   }
 
