@@ -278,7 +278,7 @@ static void balls_in_a_row_on_a_slope(std::size_t balls, int min_held = 20) {
           Scene sc = scene_of(bodies, {wall("slope", {0.0, 0.0}, 40.0 * t, 0.0)}, {0.0, -g});
           for (std::size_t k = 0; k < N; ++k) {
             MaterialOverride m;
-            m.a = "b" + std::to_string(k);
+            m.a = bodies[index[k]].name;
             m.b = "slope";
             m.friction = mu[k];
             sc.materials.push_back(m);
@@ -421,14 +421,14 @@ TEST(CoreResting, BallsInARowSlidingToAStopMeetRigidCoulomb) {
             Scene sc = scene_of(bodies, {wall("floor", {0.0, 0.0}, 40.0 * t, 0.0)}, {0.0, -g});
             for (std::size_t k = 0; k < N; ++k) {
               MaterialOverride m;
-              m.a = "b" + std::to_string(k);
+              m.a = bodies[index[k]].name;
               m.b = "floor";
               m.friction = mu[k];
               sc.materials.push_back(m);
               for (std::size_t l = k + 1; l < N; ++l) {
                 MaterialOverride p;
                 p.a = m.a;
-                p.b = "b" + std::to_string(l);
+                p.b = bodies[index[l]].name;
                 p.friction = 0.0;
                 sc.materials.push_back(p);
               }
