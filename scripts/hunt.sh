@@ -20,6 +20,7 @@
 #             must meet it to 1e-6 or better
 #   kink      concave and convex kinks of a track (two walls or a surface): core to 1e-7
 #   inclinebounce, pointsettle   a bounce with friction on a slope, a point bouncing to rest
+#   train     two balls sliding as one train (or apart) to a stop on a floor: core to 1e-8
 #   draglin, dragquad, thrust, dragwall   the converged reference must meet the closed form
 #   every closed-form run: an engine's position_divergence must see its miss
 #   box       a point or a ball at 5-5000 m/s in a box of walls (0.3-20 m), axis, 17 deg and
@@ -549,6 +550,57 @@ to = [5.0, 0.0]
 restitution = {e}
 """, [0.5, y], [0.0, vy], 1e-8)
 
+# train: a ball of friction mu_b touching one of mu_f ahead, both at v0 on a floor (e 0,
+# no friction between them): together at g (m_b mu_b + m_f mu_f) / (m_b + m_f) when
+# mu_b < mu_f, else apart at their own mu g; both stop and stay.
+for mub, muf in [(0.1, 0.5), (0.5, 0.1), (0.0, 0.3), (0.3, 0.3), (0.2, 0.6)]:
+    for mb, mf in [(1.0, 1.0), (3.0, 1.0), (1.0, 3.0)]:
+        for v0 in [1.0, 4.0]:
+            for order in [0, 1]:
+                ab = g * (mub * mb + muf * mf) / (mb + mf) if mub < muf else g * mub
+                af = ab if mub < muf else g * muf
+                T = 1.2 * v0 / min(ab if ab > 0 else 1e9, af)
+                def slid(a, x0):
+                    if a == 0:
+                        return x0 + v0 * T, v0
+                    t = min(T, v0 / a)
+                    return x0 + v0 * t - 0.5 * a * t * t, max(0.0, v0 - a * T)
+                (xb, vb), (xf, vf) = slid(ab, -0.5), slid(af, 0.5)
+                bodies = [("back", -0.5, mb), ("front", 0.5, mf)][::(-1 if order else 1)]
+                txt = "".join(f"""[[bodies]]
+name = "{nm}"
+radius = 0.5
+mass = {m}
+position = [{x}, 0.5]
+velocity = [{v0}, 0.0]
+restitution = 0.0
+""" for nm, x, m in bodies)
+                n = f"train_{mub}_{muf}_{mb}_{mf}_{v0}_{order}".replace(".", "p")
+                exact(n, f"""name = "{n}"
+duration = {T!r}
+[world]
+gravity = [0.0, -{g}]
+{txt}[[walls]]
+name = "floor"
+from = [-50.0, 0.0]
+to = [50.0, 0.0]
+restitution = 0.0
+friction = 1.0
+[[materials]]
+a = "back"
+b = "floor"
+friction = {mub}
+[[materials]]
+a = "front"
+b = "floor"
+friction = {muf}
+[[materials]]
+a = "back"
+b = "front"
+friction = 0.0
+""", [xb, 0.5], [vb, 0.0], 1e-8)
+                truth[n]["front"] = {"position": [xf, 0.5], "velocity": [vf, 0.0]}
+
 # box: a point or a 5 cm ball at 5-5000 m/s in a box of four walls (half-width 0.3-20 m),
 # e = 1, with and without gravity, along an axis, at 17 degrees, and into the corners.
 for v in [5, 50, 200, 1000, 5000]:
@@ -649,15 +701,20 @@ def ref_final(sc):
         return None
     rows = [l.strip().split(",") for l in open(path) if l.strip()]
     d = dict(zip(rows[0], map(float, rows[-1])))
-    return [d["x_b"], d["y_b"]]
+    return [d["x_b"], d["y_b"]] if "x_b" in d else [d["x_back"], d["y_back"]]
 refs = {x["scenario"]: x for x in json.load(open(sys.argv[1]))["references"]}
 for r in runs:
     sc, eng = r["scenario"], r["engine"]
     t = truth.get(sc)
     if t is None or r["status"] in ("unsupported", "error"):
         continue
-    f = [b for b in r["final"] if b["body"] == "b"][0]
+    first = "back" if sc.startswith("train_") else "b"
+    f = [b for b in r["final"] if b["body"] == first][0]
     err = max(math.dist(f["position"], t["position"]), math.dist(f["velocity"], t["velocity"]))
+    for b in r["final"]:
+        if b["body"] in t and isinstance(t[b["body"]], dict):
+            e2 = t[b["body"]]
+            err = max(err, math.dist(b["position"], e2["position"]), math.dist(b["velocity"], e2["velocity"]))
     if eng == "core" and t["judge"] == "core" and err > t["tol"]:
         found.append(f"CORE WRONG {sc}: {err:.3g} off its closed form (tolerance {t['tol']:.3g}), status {r['status']}")
     if eng == "core" and t["judge"] == "reference":

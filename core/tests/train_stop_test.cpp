@@ -53,7 +53,7 @@ std::pair<double, double> decelerated(double v0, double a, double T) {
   return {v0 * t - 0.5 * a * t * t, T < ts ? v0 - a * T : 0.0};
 }
 
-TEST(CoreTrainStop, DISABLED_TwoBallsSlidingAsOneStopTogetherAndStay) {
+TEST(CoreTrainStop, TwoBallsSlidingAsOneStopTogetherAndStay) {
   int judged = 0;
   for (const auto& [mub, muf] : std::vector<std::pair<double, double>>{{0.1, 0.5}, {0.5, 0.1}, {0.0, 0.3}, {0.3, 0.3}, {0.2, 0.6}}) {
     for (const auto& [mb, mf] : std::vector<std::pair<double, double>>{{1.0, 1.0}, {3.0, 1.0}, {1.0, 3.0}}) {
@@ -82,7 +82,7 @@ TEST(CoreTrainStop, DISABLED_TwoBallsSlidingAsOneStopTogetherAndStay) {
   EXPECT_EQ(judged, 60);
 }
 
-TEST(CoreTrainStop, DISABLED_UphillTheFrictionlessBackBallSlidesBackFromTheStop) {
+TEST(CoreTrainStop, UphillTheFrictionlessBackBallSlidesBackFromTheStop) {
   for (double deg : {5.0, 15.0}) {
     for (double v0 : {1.0, 3.0}) {
       for (bool front_first : {false, true}) {
@@ -107,6 +107,76 @@ TEST(CoreTrainStop, DISABLED_UphillTheFrictionlessBackBallSlidesBackFromTheStop)
       }
     }
   }
+}
+
+
+// The back ball catches the front one (e 0 between them, flat floor): the impact makes
+// their normal velocities equal (momentum), then they slide as one train if the back one
+// has the smaller friction, else part; both stop. Every piece closed form; the catch-up
+// time by bisection on the two decelerating paths.
+// Open (README, The hunt for wrong greens, trains): after the impact the pressed pair
+// micro-bounces (min_sep = 0.5 v_r, 17 events a step) instead of becoming a train, since a
+// train forms only at a step's start from a pair touching with no relative normal velocity,
+// which a micro-bouncing pair never is; it ends 2e-7 m off. Not a wrong green (first order,
+// the reference's convergence check sees it), but not exact.
+TEST(CoreTrainStop, DISABLED_ABallCatchingAnotherSlidesOnWithItAsOneTrain) {
+  int judged = 0;
+  for (const auto& [mub, muf] : std::vector<std::pair<double, double>>{{0.1, 0.5}, {0.0, 0.3}, {0.2, 0.6}, {0.5, 0.1}}) {
+    for (const auto& [mb, mf] : std::vector<std::pair<double, double>>{{1.0, 1.0}, {3.0, 1.0}, {1.0, 3.0}}) {
+      for (double vb0 : {2.0, 5.0}) {
+        for (bool front_first : {false, true}) {
+          const double vf0 = 0.5, gap = 0.3;
+          const auto x_of = [](double x0, double v0, double a, double t) {
+            if (a == 0.0) return x0 + v0 * t;
+            const double ts = v0 / a, u = std::min(t, ts);
+            return x0 + v0 * u - 0.5 * a * u * u;
+          };
+          const auto v_of = [](double v0, double a, double t) { return a == 0.0 ? v0 : std::max(0.0, v0 - a * t); };
+          const double ab = g * mub, af = g * muf;
+          // Catch-up: x_b(t) + 1 = x_f(t) (centres 1 m apart when touching).
+          double lo = 0.0, hi = 10.0;
+          if (x_of(-0.5 - gap, vb0, ab, hi) + 1.0 < x_of(0.5, vf0, af, hi)) continue;   // never
+          for (int k = 0; k < 200; ++k) {
+            const double mid = 0.5 * (lo + hi);
+            (x_of(-0.5 - gap, vb0, ab, mid) + 1.0 < x_of(0.5, vf0, af, mid) ? lo : hi) = mid;
+          }
+          const double t1 = hi, xf1 = x_of(0.5, vf0, af, t1);
+          const double vb1 = v_of(vb0, ab, t1), vf1 = v_of(vf0, af, t1);
+          const double v = (mb * vb1 + mf * vf1) / (mb + mf);   // e = 0
+          const bool together = mub < muf;
+          const double a_b = together ? g * (mub * mb + muf * mf) / (mb + mf) : ab, a_f = together ? a_b : af;
+          const double T = t1 + 1.2 * v / std::min(a_b > 0.0 ? a_b : 1e9, a_f);
+          BodyDef back = circle("back", {-0.5 - gap, 0.5}, {vb0, 0.0}, 0.5, mb, 0.0);
+          BodyDef front = circle("front", {0.5, 0.5}, {vf0, 0.0}, 0.5, mf, 0.0);
+          std::vector<BodyDef> b = {back, front};
+          if (front_first) std::swap(b[0], b[1]);
+          Scene sc = scene_of(b, {wall("floor", {-60.0, 0.0}, {60.0, 0.0}, 0.0, 1.0)}, {0.0, -g});
+          sc.materials.push_back(pair_friction("back", "floor", mub));
+          sc.materials.push_back(pair_friction("front", "floor", muf));
+          sc.materials.push_back(pair_friction("back", "front", 0.0));
+          Sim sim(sc);
+          std::int64_t worst_events = 0;
+          int steps = 0;
+          while (sim.engine.time() < T - 1e-12) {
+            sim.step(std::min(1.0 / 60.0, T - sim.engine.time()));
+            if (sim.engine.time() > t1 + 2.0 / 60.0) worst_events = std::max(worst_events, sim.engine.last_step_stats().events);
+            ++steps;
+          }
+          const std::string where = "mu " + std::to_string(mub) + "/" + std::to_string(muf) + " m " + std::to_string(mb) +
+                                    "/" + std::to_string(mf) + " vb0 " + std::to_string(vb0) + (front_first ? " front first" : "");
+          const double s = T - t1;
+          EXPECT_EQ(sim.engine.broken_guarantee(), "") << where;
+          EXPECT_NEAR(sim.state("back").position.x, x_of(xf1 - 1.0, v, a_b, s), 1e-9) << where;
+          EXPECT_NEAR(sim.state("front").position.x, x_of(xf1, v, a_f, s), 1e-9) << where;
+          EXPECT_NEAR(sim.state("back").velocity.x, a_b == 0.0 ? v : v_of(v, a_b, s), 1e-9) << where;
+          EXPECT_NEAR(sim.state("front").velocity.x, v_of(v, a_f, s), 1e-9) << where;
+          EXPECT_LE(worst_events, 2) << where;   // a train, not a pair micro-bouncing
+          ++judged;
+        }
+      }
+    }
+  }
+  EXPECT_GT(judged, 40);
 }
 
 }  // namespace
