@@ -164,50 +164,49 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
   }
 
   void pairs(std::vector<BodyPair>& out) override {
-    static constexpr std::int32_t kForward[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
-    // The forward neighbours of the last home cell seen: the bodies of a bucket mostly
-    // share one, so its buckets are looked up once per bucket, not once per body.
-    struct Neighbour {
-      std::int32_t x, y;
-      std::uint32_t begin, end;   // its bucket's positions (empty: off the int32 range)
-    };
-    Neighbour near[4];
-    std::int32_t last_x = 0, last_y = 0;
-    bool have_last = false;
+    // Each body's forward neighbours: the later bodies of its own cell, the cell to its
+    // right, and the three cells of the row above. With the tiling unbroken there
+    // (the usual case), its own and the right cell's buckets are consecutive, and so
+    // are the three above: two runs of positions, each tested without a branch per
+    // box (the overlap test mostly fails, and unpredictably). Bodies of other cells
+    // that share those buckets are told apart by their home cells.
+    const std::uint32_t wmask = hash_.wmask, hmask = hash_.hmask;
+    std::size_t used = out.size();
     for (std::uint32_t b = 0; b < hash_.buckets; ++b) {
       const std::uint32_t end = start_[b + 1];
       for (std::uint32_t k = start_[b]; k < end; ++k) {
         const Slot& sk = slots_[k];
-        const Aabb& a = sk.box;
         const std::int32_t cx = sk.hx, cy = sk.hy;
-        for (std::uint32_t k2 = k + 1; k2 < end; ++k2) {
+        const std::uint32_t tx = static_cast<std::uint32_t>(cx) & wmask;
+        if (tx == 0 || tx == wmask || (static_cast<std::uint32_t>(cy) & hmask) == hmask) {
+          pairs_generic(k, end, out, used);
+          continue;
+        }
+        const std::uint32_t up = hash_(cx, cy + 1);   // the bucket above: (cx, cy + 1)
+        const std::uint32_t r0 = k + 1, r1 = start_[b + 2];
+        const std::uint32_t u0 = start_[up - 1], u1 = start_[up + 2];
+        const std::size_t need = used + (r1 - r0) + (u1 - u0);
+        if (out.size() < need) out.resize(std::max<std::size_t>(need, 2 * out.size() + 64));
+        BodyPair* o = out.data();
+        const Aabb a = sk.box;
+        const std::uint32_t body = sk.body;
+        const auto ucx = static_cast<std::uint32_t>(cx);
+        for (std::uint32_t k2 = r0; k2 < r1; ++k2) {
           const Slot& s2 = slots_[k2];
-          if (overlaps(a, s2.box) && s2.hx == cx && s2.hy == cy) push(out, sk.body, s2.body);
+          const bool hit = overlaps_nb(a, s2.box) & (s2.hy == cy) & (static_cast<std::uint32_t>(s2.hx) - ucx <= 1u);
+          o[used] = ordered(body, s2.body);
+          used += hit;
         }
-        if (!have_last || cx != last_x || cy != last_y) {
-          have_last = true;
-          last_x = cx;
-          last_y = cy;
-          for (int d = 0; d < 4; ++d) {
-            const std::int64_t nx = static_cast<std::int64_t>(cx) + kForward[d][0];
-            const std::int64_t ny = static_cast<std::int64_t>(cy) + kForward[d][1];
-            if (nx > 2147483646 || nx < -2147483647 || ny > 2147483646) {
-              near[d] = {0, 0, 0, 0};
-              continue;
-            }
-            const auto ncx = static_cast<std::int32_t>(nx), ncy = static_cast<std::int32_t>(ny);
-            const std::uint32_t nb = hash_(ncx, ncy);
-            near[d] = {ncx, ncy, start_[nb], start_[nb + 1]};
-          }
-        }
-        for (const Neighbour& nd : near) {
-          for (std::uint32_t k2 = nd.begin; k2 < nd.end; ++k2) {
-            const Slot& s2 = slots_[k2];
-            if (overlaps(a, s2.box) && s2.hx == nd.x && s2.hy == nd.y) push(out, sk.body, s2.body);
-          }
+        const std::int32_t uy = cy + 1;
+        for (std::uint32_t k2 = u0; k2 < u1; ++k2) {
+          const Slot& s2 = slots_[k2];
+          const bool hit = overlaps_nb(a, s2.box) & (s2.hy == uy) & (static_cast<std::uint32_t>(s2.hx) - ucx + 1u <= 2u);
+          o[used] = ordered(body, s2.body);
+          used += hit;
         }
       }
     }
+    out.resize(used);
     for (std::uint32_t o : oversize_) {
       const Aabb& a = box(o);
       for (std::uint32_t j = 0; j < active_.size(); ++j) {
@@ -320,6 +319,39 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     extra_body_.push_back(entry);
     extra_next_.push_back(extra_head_[bucket]);
     extra_head_[bucket] = static_cast<std::uint32_t>(extra_body_.size() - 1);
+  }
+  // overlaps() without the short-circuit branches.
+  static bool overlaps_nb(const Aabb& a, const Aabb& b) {
+    return (a.min_x <= b.max_x) & (b.min_x <= a.max_x) & (a.min_y <= b.max_y) & (b.min_y <= a.max_y);
+  }
+  static BodyPair ordered(std::uint32_t i, std::uint32_t j) { return i < j ? BodyPair{i, j} : BodyPair{j, i}; }
+  // The forward pairs of the body at position k (its bucket ends at `end`), each
+  // neighbouring cell's bucket looked up through the hash: for cells where the tiling
+  // wraps (and a scene wider or taller than the tiles).
+  void pairs_generic(std::uint32_t k, std::uint32_t end, std::vector<BodyPair>& out, std::size_t& used) const {
+    const auto emit = [&](std::uint32_t i, std::uint32_t j) {
+      if (used == out.size()) out.resize(2 * out.size() + 64);
+      out[used++] = ordered(i, j);
+    };
+    static constexpr std::int32_t kForward[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
+    const Slot& sk = slots_[k];
+    const Aabb& a = sk.box;
+    const std::int32_t cx = sk.hx, cy = sk.hy;
+    for (std::uint32_t k2 = k + 1; k2 < end; ++k2) {
+      const Slot& s2 = slots_[k2];
+      if (overlaps(a, s2.box) && s2.hx == cx && s2.hy == cy) emit(sk.body, s2.body);
+    }
+    for (int d = 0; d < 4; ++d) {
+      const std::int64_t nx = static_cast<std::int64_t>(cx) + kForward[d][0];
+      const std::int64_t ny = static_cast<std::int64_t>(cy) + kForward[d][1];
+      if (nx > 2147483646 || nx < -2147483647 || ny > 2147483646) continue;
+      const auto ncx = static_cast<std::int32_t>(nx), ncy = static_cast<std::int32_t>(ny);
+      const std::uint32_t nb = hash_(ncx, ncy);
+      for (std::uint32_t k2 = start_[nb]; k2 < start_[nb + 1]; ++k2) {
+        const Slot& s2 = slots_[k2];
+        if (overlaps(a, s2.box) && s2.hx == ncx && s2.hy == ncy) emit(sk.body, s2.body);
+      }
+    }
   }
   static void push(std::vector<BodyPair>& out, std::uint32_t i, std::uint32_t j) {
     out.push_back(i < j ? BodyPair{i, j} : BodyPair{j, i});
