@@ -235,7 +235,38 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
       }
       return;
     }
+    // A row whose cells are consecutive buckets (the tiling does not wrap within it) and
+    // hold no extra entries is one run of positions: scanned without a branch per box,
+    // in the order the cell-by-cell scan below reports (bucket by bucket, each in
+    // position order). Any body whose home moved within the row has an extra entry
+    // there, so a run's bodies are at home: in the row and within [x0, x1].
+    const std::uint32_t span = static_cast<std::uint32_t>(x1) - static_cast<std::uint32_t>(x0);
+    const bool runs = span < hash_.wmask + 1u &&
+                      (static_cast<std::uint32_t>(x0) & hash_.wmask) <= (static_cast<std::uint32_t>(x1) & hash_.wmask);
     for (std::int32_t y = y0;; ++y) {
+      if (runs) {
+        const std::uint32_t b0 = hash_(x0, y), b1 = b0 + span;
+        std::uint32_t extras = kNil;
+        for (std::uint32_t b = b0; b <= b1; ++b) extras &= extra_head_[b];
+        if (extras == kNil) {
+          const std::uint32_t p0 = start_[b0], p1 = start_[b1 + 1];
+          std::size_t used = out.size();
+          out.resize(used + (p1 - p0));
+          std::uint32_t* o = out.data();
+          const auto ux0 = static_cast<std::uint32_t>(x0);
+          for (std::uint32_t k = p0; k < p1; ++k) {
+            Slot& sl = slots_[k];
+            const bool hit = (sl.hy == y) & (static_cast<std::uint32_t>(sl.hx) - ux0 <= span) & overlaps_nb(q, sl.box) &
+                             (sl.stamp != stamp);
+            o[used] = sl.body;
+            used += hit;
+            sl.stamp = hit ? stamp : sl.stamp;
+          }
+          out.resize(used);
+          if (y == y1) break;
+          continue;
+        }
+      }
       for (std::int32_t x = x0;; ++x) {
         const std::uint32_t b = hash_(x, y);
         for (std::uint32_t k = start_[b]; k < start_[b + 1]; ++k) visit(k, x, y, q, stamp, out);
