@@ -63,7 +63,18 @@ class EventLoop {
         T_(ctx.dt),
         coupled_(w.coupled()),
         fast_isolated_(w.impact_law == ImpactLaw::Simultaneous && !w.any_rules && !w.any_forces && !w.varying_forces &&
-                       !w.coupled()) {}
+                       !w.coupled()) {
+    // A few faces: their boxes, as StaticGeometry builds them, to skip its query for
+    // a box that meets none (most bodies of a walled gas, away from the walls).
+    if (w.statics.segments.size() <= kFewFaces) {
+      for (const Segment& s : w.statics.segments) {
+        face_boxes_[face_count_++] = make_aabb(std::min(s.from.x, s.to.x), std::min(s.from.y, s.to.y),
+                                               std::max(s.from.x, s.to.x), std::max(s.from.y, s.to.y));
+      }
+    } else {
+      face_count_ = kManyFaces;
+    }
+  }
 
   void run() {
     prune_passing(w_);
@@ -227,8 +238,16 @@ class EventLoop {
     push(Event::make(t + s, i, j, w_.version[i], w_.version[j], EventKind::Pair));
   }
 
+  // Whether a face's box may overlap `box` (false: StaticGeometry::query finds none).
+  bool may_meet_faces(const Aabb& box) const {
+    if (face_count_ == kManyFaces) return true;
+    bool any = false;
+    for (std::uint32_t k = 0; k < face_count_; ++k) any |= overlaps(box, face_boxes_[k]);
+    return any;
+  }
+
   void schedule_statics(std::uint32_t i, double t, const Aabb& box) {
-    if (w_.statics.segments.empty()) return;
+    if (!may_meet_faces(box)) return;
     w_.found_static.clear();
     w_.statics.query(box, w_.found_static);
     if (w_.found_static.empty()) return;
@@ -387,8 +406,10 @@ class EventLoop {
   bool near_face(Vec2 p, double r, std::uint32_t except) {
     if (w_.statics.segments.empty()) return false;
     const double pad = r * (1.0 + 1e-6) + 1e-9 * (inf_norm(p) + w_.length_scale);
+    const Aabb box = make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad);
+    if (!may_meet_faces(box)) return false;
     w_.found_static.clear();
-    w_.statics.query(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), w_.found_static);
+    w_.statics.query(box, w_.found_static);
     for (std::uint32_t k : w_.found_static) {
       if (k == except) continue;
       const Segment& s = w_.statics.segments[k];
@@ -856,6 +877,9 @@ class EventLoop {
   // near is the pairwise law's, proven without the touching set (isolated_pair).
   const bool fast_isolated_;
   Aabb found_box_i_, found_box_j_;   // the new paths' boxes isolated_pair/_static found
+  static constexpr std::uint32_t kFewFaces = 8, kManyFaces = 0xffffffffu;
+  Aabb face_boxes_[kFewFaces];       // the faces' boxes, when there are few (face_count_)
+  std::uint32_t face_count_ = 0;     // kManyFaces: ask StaticGeometry every time
   std::vector<std::uint32_t> set_;      // the touching set of a simultaneous impact
   std::vector<BodyPair> impacted_;      // its pairs that took an impulse
   std::vector<std::uint32_t> near_;     // bodies near one being held
