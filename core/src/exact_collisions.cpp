@@ -229,6 +229,16 @@ class EventLoop {
     const Vec2 d0 = pj - pi;
     if (dot(d0, dv) >= 0.0 && dot(d0, da) >= 0.0 && length_squared(d0) >= R * R) return;
     const double scale = inf_norm(pi) + inf_norm(pj) + R;
+    if (da.x == 0.0 && da.y == 0.0) {
+      // toi::circle_circle's own rejections (separating, or never close enough), before
+      // the speed its tolerance needs costs two square roots: its touch tolerance is
+      // toi::squared_tolerance's, computed the same way.
+      const double b = dot(d0, dv);
+      const double c = dot(d0, d0) - R * R;
+      const double touch = 2.0 * R * 64.0 * 2.220446049250313e-16 * scale + 64.0 * 2.220446049250313e-16 * R * R;
+      if (b >= 0.0 && c > touch) return;
+      if (c > touch && b * b < dot(dv, dv) * c) return;
+    }
     // Round-off in dv is that of the bodies' own velocities, not of their difference: two
     // touching bodies moving together (an inelastic pair) approach at ~1e-17 m/s, an
     // impulse that small changes no velocity, and the same impact would fire forever.
