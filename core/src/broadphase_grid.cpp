@@ -120,33 +120,48 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     hash_.choose(count, cells_x, cells_y);
 
     // Each body's bucket (kNil: inactive or oversize), counted.
-    start_.assign(hash_.buckets + 2, 0);
+    // (Through local pointers: the stores into one array would otherwise make the
+    // compiler reload the others' and the members' values in every iteration.)
+    const std::uint32_t buckets = hash_.buckets;
+    const bp_detail::TileHash hash = hash_;
+    const double cell_edge = cell_;
+    start_.assign(buckets + 2, 0);
     pos_of_.resize(n);
+    std::uint32_t* const start = start_.data();
+    std::uint32_t* const pos_of = pos_of_.data();
+    const Aabb* const boxes = boxes_.data();
+    const std::uint8_t* const act = active_.data();
     for (std::uint32_t i = 0; i < n; ++i) {
-      pos_of_[i] = kNil;
-      if (!active_[i]) continue;
-      if (bp_detail::extent(boxes_[i]) > cell_) {
+      pos_of[i] = kNil;
+      if (!act[i]) continue;
+      if (bp_detail::extent(boxes[i]) > cell_edge) {
         oversize_.push_back(i);
         continue;
       }
       std::int32_t cx, cy;
-      centre_cell(boxes_[i], cx, cy);
-      pos_of_[i] = hash_(cx, cy);
-      ++start_[pos_of_[i] + 2];
+      centre_cell(boxes[i], cx, cy);
+      const std::uint32_t b = hash(cx, cy);
+      pos_of[i] = b;
+      ++start[b + 2];
     }
     // Counting sort: start_[b + 1] becomes the fill cursor of bucket b, then its end.
     // Each body's slot is written whole where it lands (stamp 0: no query has it).
-    for (std::uint32_t b = 0; b < hash_.buckets; ++b) start_[b + 2] += start_[b + 1];
-    std::uint32_t tail = start_[hash_.buckets + 1];   // unbinned bodies after the buckets
+    std::uint32_t running = 0;
+    for (std::uint32_t b = 0; b < buckets; ++b) {
+      running += start[b + 2];
+      start[b + 2] = running;
+    }
+    std::uint32_t tail = start[buckets + 1];   // unbinned bodies after the buckets
+    Slot* const slots = slots_.data();
     for (std::uint32_t i = 0; i < n; ++i) {
-      const std::uint32_t k = pos_of_[i] == kNil ? tail++ : start_[pos_of_[i] + 1]++;
+      const std::uint32_t k = pos_of[i] == kNil ? tail++ : start[pos_of[i] + 1]++;
       Slot s;
-      s.box = boxes_[i];
+      s.box = boxes[i];
       centre_cell(s.box, s.hx, s.hy);
       s.body = i;
       s.stamp = 0;
-      slots_[k] = s;
-      pos_of_[i] = k;
+      slots[k] = s;
+      pos_of[i] = k;
     }
     for (std::uint32_t o : oversize_) {
       slots_[pos_of_[o]].hx = kOversizeHome;
