@@ -185,21 +185,26 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     // are the three above: two runs of positions, each tested without a branch per
     // box (the overlap test mostly fails, and unpredictably). Bodies of other cells
     // that share those buckets are told apart by their home cells.
-    const std::uint32_t wmask = hash_.wmask, hmask = hash_.hmask;
+    // (Local copies: the pairs' stores would otherwise make the compiler reload the
+    // members after each.)
+    const bp_detail::TileHash hash = hash_;
+    const std::uint32_t wmask = hash.wmask, hmask = hash.hmask;
+    const std::uint32_t* const start = start_.data();
+    const Slot* const slots = slots_.data();
     std::size_t used = out.size();
-    for (std::uint32_t b = 0; b < hash_.buckets; ++b) {
-      const std::uint32_t end = start_[b + 1];
-      for (std::uint32_t k = start_[b]; k < end; ++k) {
-        const Slot& sk = slots_[k];
+    for (std::uint32_t b = 0; b < hash.buckets; ++b) {
+      const std::uint32_t end = start[b + 1];
+      for (std::uint32_t k = start[b]; k < end; ++k) {
+        const Slot& sk = slots[k];
         const std::int32_t cx = sk.hx, cy = sk.hy;
         const std::uint32_t tx = static_cast<std::uint32_t>(cx) & wmask;
         if (tx == 0 || tx == wmask || (static_cast<std::uint32_t>(cy) & hmask) == hmask) {
           pairs_generic(k, end, out, used);
           continue;
         }
-        const std::uint32_t up = hash_(cx, cy + 1);   // the bucket above: (cx, cy + 1)
-        const std::uint32_t r0 = k + 1, r1 = start_[b + 2];
-        const std::uint32_t u0 = start_[up - 1], u1 = start_[up + 2];
+        const std::uint32_t up = hash(cx, cy + 1);   // the bucket above: (cx, cy + 1)
+        const std::uint32_t r0 = k + 1, r1 = start[b + 2];
+        const std::uint32_t u0 = start[up - 1], u1 = start[up + 2];
         const std::size_t need = used + (r1 - r0) + (u1 - u0);
         if (out.size() < need) out.resize(std::max<std::size_t>(need, 2 * out.size() + 64));
         BodyPair* o = out.data();
@@ -207,14 +212,14 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
         const std::uint32_t body = sk.body;
         const auto ucx = static_cast<std::uint32_t>(cx);
         for (std::uint32_t k2 = r0; k2 < r1; ++k2) {
-          const Slot& s2 = slots_[k2];
+          const Slot& s2 = slots[k2];
           const bool hit = overlaps_nb(a, s2.box) & (s2.hy == cy) & (static_cast<std::uint32_t>(s2.hx) - ucx <= 1u);
           o[used] = ordered(body, s2.body);
           used += hit;
         }
         const std::int32_t uy = cy + 1;
         for (std::uint32_t k2 = u0; k2 < u1; ++k2) {
-          const Slot& s2 = slots_[k2];
+          const Slot& s2 = slots[k2];
           const bool hit = overlaps_nb(a, s2.box) & (s2.hy == uy) & (static_cast<std::uint32_t>(s2.hx) - ucx + 1u <= 2u);
           o[used] = ordered(body, s2.body);
           used += hit;
