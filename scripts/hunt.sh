@@ -15,6 +15,15 @@
 #   vtrough   a ball into a symmetric V (half-angle 50-85 deg, e 0/0.3/0.7, both wall orders)
 #   headon    head-on pairs, mass ratios 1e-6..1e6, e 0/0.5/1, sizes 1 mm..1 km, with their
 #             closed forms as [expect]: core must meet them; no engine may pass a 10% miss
+#   floorslide, settle, slope, edge   one body's closed form (friction stop, bounces to rest,
+#             held or sliding on a slope drawn three ways, sliding off a table's end): core
+#             must meet it to 1e-6 or better
+#   kink      concave and convex kinks of a track (two walls or a surface): core to 1e-7
+#   inclinebounce, pointsettle   a bounce with friction on a slope, a point bouncing to rest
+#   draglin, dragquad, thrust, dragwall   the converged reference must meet the closed form
+#   every closed-form run: an engine's position_divergence must see its miss
+#   box       a point or a ball at 5-5000 m/s in a box of walls (0.3-20 m), axis, 17 deg and
+#             corners, with and without gravity: core never leaves, no engine is ok outside it
 set -euo pipefail
 build=build
 jobs=$(nproc)
@@ -186,6 +195,389 @@ restitution = {e}
 final = [ {{ body = "a", velocity = [{v1!r}, 0.0], tolerance = {tol!r} }},
           {{ body = "b", velocity = [{v2!r}, 0.0], tolerance = {tol!r} }} ]
 ''')
+
+# Closed forms for the models one body at a time (truth.json: the exact final state, and
+# the tolerance core, the reference, must meet it to). Found by this grid: `edge`.
+truth = {}
+g = 9.8
+def exact(name, text, pos, vel, tol, judge="core"):
+    write(name, text)
+    truth[name] = {"position": pos, "velocity": vel, "tol": tol, "judge": judge}
+
+# floorslide: a ball sliding on a floor, kinetic or rolling friction mu: decelerated by
+# mu g until it stops at v0^2 / (2 mu g) (T before and after the stop).
+for kind in ["friction", "rolling_friction"]:
+    for v0 in [0.5, 3.0, 12.0]:
+        for mu in [0.05, 0.3, 1.0]:
+            for frac in [0.6, 1.5]:
+                for steps in [60, 240]:
+                    ts = v0 / (mu * g)
+                    t = min(frac * ts, ts)
+                    x, v = v0 * t - 0.5 * mu * g * t * t, (v0 - mu * g * t if frac < 1 else 0.0)
+                    n = f"floorslide_{kind[0]}_{v0}_{mu}_{frac}_{steps}".replace(".", "p")
+                    exact(n, f"""name = "{n}"
+duration = {frac * ts!r}
+dt = "1/{steps}"
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+radius = 0.5
+position = [0.0, 0.5]
+velocity = [{v0}, 0.0]
+restitution = 0.0
+{kind} = {mu}
+[[walls]]
+name = "floor"
+from = [-200.0, 0.0]
+to = [200.0, 0.0]
+restitution = 0.0
+{kind} = {mu}
+""", [x, 0.5], [v, 0.0], 1e-7 * max(1.0, x))
+
+# settle: a drop from h with restitution e, before and after it comes to rest
+# (t_inf = sqrt(2h/g) (1+e)/(1-e)): the bounces' closed form at T.
+def bounce_state(h, e, T):
+    t = math.sqrt(2 * h / g)
+    if T <= t:
+        return h - 0.5 * g * T * T, -g * T
+    v = e * g * t
+    while v > 1e-12:
+        if T <= t + 2 * v / g:
+            s = T - t
+            return v * s - 0.5 * g * s * s, v - g * s
+        t += 2 * v / g
+        v *= e
+    return 0.0, 0.0
+for h in [0.3, 2.0, 10.0]:
+    for e in [0.0, 0.3, 0.6, 0.9]:
+        tinf = math.sqrt(2 * h / g) * (1 + e) / (1 - e)
+        for frac in [0.37, 0.93, 1.3]:
+            for steps in [60, 1000]:
+                y, vy = bounce_state(h, e, frac * tinf)
+                n = f"settle_{h}_{e}_{frac}_{steps}".replace(".", "p")
+                exact(n, f"""name = "{n}"
+duration = {frac * tinf!r}
+dt = "1/{steps}"
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+radius = 0.25
+position = [1.0, {h + 0.25!r}]
+restitution = {e}
+[[walls]]
+name = "floor"
+from = [-20.0, 0.0]
+to = [20.0, 0.0]
+restitution = {e}
+""", [1.0, y + 0.25], [0.0, vy], 1e-7 * max(1.0, h))
+
+# drag: linear drag with a wind (across) and quadratic drag (a fall): the converged
+# reference must meet the closed forms (core's own step is second order).
+for m in [0.5, 2.0]:
+    for k in [0.1, 1.0, 5.0]:
+        c, T, wx, v0x = k / m, 3.0, 3.0, -1.0
+        vt = g / c
+        n = f"draglin_{m}_{k}".replace(".", "p")
+        exact(n, f"""name = "{n}"
+duration = {T}
+[world]
+gravity = [0.0, -{g}]
+wind = [{wx}, 0.0]
+[[bodies]]
+name = "b"
+radius = 0.1
+mass = {m}
+position = [0.0, 100.0]
+velocity = [{v0x}, 0.0]
+drag_linear = {k}
+""", [wx * T + (v0x - wx) * (1 - math.exp(-c * T)) / c, 100.0 - vt * (T - (1 - math.exp(-c * T)) / c)],
+              [wx + (v0x - wx) * math.exp(-c * T), -vt * (1 - math.exp(-c * T))], 1e-8 * 100, "reference")
+    for k2 in [0.01, 0.1, 1.0]:
+        T = 3.0
+        vt = math.sqrt(m * g / k2)
+        n = f"dragquad_{m}_{k2}".replace(".", "p")
+        exact(n, f"""name = "{n}"
+duration = {T}
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+radius = 0.1
+mass = {m}
+position = [0.0, 100.0]
+drag_quadratic = {k2}
+""", [0.0, 100.0 - vt * vt / g * math.log(math.cosh(g * T / vt))], [0.0, -vt * math.tanh(g * T / vt)],
+              1e-8 * 100, "reference")
+
+# slope: a ball at rest on a slope (a wall drawn down or up, or a surface), mu_k = 0.75
+# mu_s: held iff tan(theta) <= mu_s, else a = g (sin - mu_k cos).
+for deg in [10, 20, 30, 45, 60]:
+    for mus in [0.2, 0.5, 0.8]:
+        for how in ["wall", "wallrev", "surface"]:
+            muk, th, T, L, r = 0.75 * mus, math.radians(deg), 1.5, 40.0, 0.5
+            d = (math.cos(th), -math.sin(th))
+            p0 = (math.sin(th) * r, math.cos(th) * r)
+            a = 0.0 if math.tan(th) <= mus else g * (math.sin(th) - muk * math.cos(th))
+            s = 0.5 * a * T * T
+            A, B = (-L * d[0], -L * d[1]), (L * d[0], L * d[1])
+            if how == "wallrev":
+                A, B = B, A
+            mat = f"friction = {muk}\nstatic_friction = {mus}\nrestitution = 0.0\n"
+            if how == "surface":   # faces the left of its point order: downhill, left is up
+                geo = f"[[surfaces]]\nname = \"slope\"\npoints = [[{A[0]!r}, {A[1]!r}], [{B[0]!r}, {B[1]!r}]]\n" + mat
+            else:
+                geo = f"[[walls]]\nname = \"slope\"\nfrom = [{A[0]!r}, {A[1]!r}]\nto = [{B[0]!r}, {B[1]!r}]\n" + mat
+            n = f"slope_{deg}_{mus}_{how}".replace(".", "p")
+            exact(n, f"""name = "{n}"
+duration = {T}
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+radius = {r}
+position = [{p0[0]!r}, {p0[1]!r}]
+{mat}{geo}""", [p0[0] + s * d[0], p0[1] + s * d[1]], [a * T * d[0], a * T * d[1]], 1e-6)
+
+# thrust: a(v) = a0 - k v from a two-point table along a heading: v = (a0/k)(1 - e^-kt).
+for a0 in [1.0, 5.0]:
+    for kk in [0.2, 1.0]:
+        for deg in [0, 37]:
+            th, T, vinf = math.radians(deg), 4.0, a0 / kk
+            v = vinf * (1 - math.exp(-kk * T))
+            s = vinf * (T - (1 - math.exp(-kk * T)) / kk)
+            n = f"thrust_{a0}_{kk}_{deg}".replace(".", "p")
+            exact(n, f"""name = "{n}"
+duration = {T}
+[[bodies]]
+name = "b"
+radius = 0.5
+position = [0.0, 0.0]
+angle = {th!r}
+[bodies.thrust]
+speeds = [0.0, 40.0]
+accel = [{a0}, {a0 - kk * 40.0!r}]
+""", [s * math.cos(th), s * math.sin(th)], [v * math.cos(th), v * math.sin(th)], 1e-7 * max(1.0, s), "reference")
+
+# edge: a ball sliding off a table's end (v^2 >= g r: it flies off at once on the
+# projectile's path; the friction decelerates it up to the end). Slower ones turn about
+# the end point (core micro-bounces there, first order: `edge_slow`, only the reference
+# is judged: converged means within its convergence error of the turn).
+for v0 in [2.5, 3.0, 5.0]:
+    for mu in [0.0, 0.1, 0.3]:
+        for steps in [60, 240]:
+            for off in [0.0, 0.013]:
+                r, x0 = 0.5, -(1.0 + off)
+                vc2 = v0 * v0 - 2 * mu * g * abs(x0)
+                if vc2 < 1.02 * g * r:
+                    continue
+                vc = math.sqrt(vc2)
+                te = (v0 - vc) / (mu * g) if mu > 0 else abs(x0) / v0
+                s = 0.4
+                n = f"edge_{v0}_{mu}_{steps}_{int(off * 1000)}".replace(".", "p")
+                exact(n, f"""name = "{n}"
+duration = {te + s!r}
+dt = "1/{steps}"
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+radius = {r}
+position = [{x0}, {r}]
+velocity = [{v0}, 0.0]
+restitution = 0.0
+friction = {mu}
+[[walls]]
+name = "table"
+from = [-10.0, 0.0]
+to = [0.0, 0.0]
+restitution = 0.0
+friction = {mu}
+""", [vc * s, r - 0.5 * g * s * s], [vc, -g * s], 1e-8)
+# dragwall: linear drag (and a wind) through a wall impact: the converged reference meets
+# the piecewise closed form (the impact time by bisection on it).
+def lin(x0, v0, c, acc, t):   # v' = acc - c v
+    vt = acc / c
+    return x0 + vt * t + (v0 - vt) * (1 - math.exp(-c * t)) / c, vt + (v0 - vt) * math.exp(-c * t)
+for k in [0.05, 0.5, 2.0]:
+    for e in [0.5, 1.0]:
+        for wind in [0.0, -2.0]:
+            c, r, xw = k, 0.2, 5.0
+            if lin(0.0, 8.0, c, c * wind, 5.0)[0] < xw - r:
+                continue   # the drag stops it short of the wall
+            lo, hi = 0.0, 5.0
+            for _ in range(200):
+                mid = 0.5 * (lo + hi)
+                lo, hi = (mid, hi) if lin(0.0, 8.0, c, c * wind, mid)[0] < xw - r else (lo, mid)
+            x1, vx1 = lin(0.0, 8.0, c, c * wind, hi)
+            y1, vy1 = lin(5.0, 2.0, c, -g, hi)
+            x2, vx2 = lin(x1, -e * vx1, c, c * wind, 0.5)
+            y2, vy2 = lin(y1, vy1, c, -g, 0.5)
+            n = f"dragwall_{k}_{e}_{int(-wind)}".replace(".", "p")
+            exact(n, f"""name = "{n}"
+duration = {hi + 0.5!r}
+[world]
+gravity = [0.0, -{g}]
+wind = [{wind}, 0.0]
+[[bodies]]
+name = "b"
+radius = {r}
+position = [0.0, 5.0]
+velocity = [8.0, 2.0]
+restitution = {e}
+drag_linear = {k}
+[[walls]]
+name = "wall"
+from = [{xw}, -20.0]
+to = [{xw}, 20.0]
+restitution = {e}
+""", [x2, y2], [vx2, vy2], 1e-8, "reference")
+
+# kink: a ball sliding (frictionless, e 0) into an upward ramp (concave: an impact, then up
+# the ramp at g sin) or off a floor onto a downward slope (convex, v^2 > g r: it flies off,
+# lands, slides), the track as two walls or one surface.
+for bdeg in [10, 20, 30, 45]:
+    for v0 in [1.0, 3.0]:
+        for how in ["walls", "surface"]:
+            b, r = math.radians(bdeg), 0.5
+            xc = r * (math.cos(b) - 1) / math.sin(b)
+            vt = v0 * math.cos(b)
+            s = 0.6 * vt / (g * math.sin(b))
+            d = vt * s - 0.5 * g * math.sin(b) * s * s
+            pts = [(-20.0, 0.0), (0.0, 0.0), (10 * math.cos(b), 10 * math.sin(b))]
+            if how == "walls":
+                geo = "".join(f"[[walls]]\nname = \"w{q}\"\nfrom = [{pts[q][0]!r}, {pts[q][1]!r}]\nto = [{pts[q + 1][0]!r}, {pts[q + 1][1]!r}]\nrestitution = 0.0\n" for q in range(2))
+            else:
+                geo = "[[surfaces]]\nname = \"track\"\npoints = [" + ", ".join(f"[{x!r}, {y!r}]" for x, y in pts) + "]\nrestitution = 0.0\n"
+            n = f"concave_{bdeg}_{v0}_{how}".replace(".", "p")
+            exact(n, f"""name = "{n}"
+duration = {1.0 / v0 + s!r}
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+radius = {r}
+position = [{xc - 1.0!r}, {r}]
+velocity = [{v0}, 0.0]
+restitution = 0.0
+{geo}""", [xc + d * math.cos(b), r + d * math.sin(b)],
+                  [(vt - g * math.sin(b) * s) * math.cos(b), (vt - g * math.sin(b) * s) * math.sin(b)], 1e-8)
+for bdeg in [10, 20, 30]:
+    for v0 in [2.5, 4.0]:
+        for how in ["walls", "surface"]:
+            b, r = math.radians(bdeg), 0.5
+            A, B, C = -0.5 * g * math.cos(b), math.sin(b) * v0, r * math.cos(b) - r
+            s1 = (-B - math.sqrt(B * B - 4 * A * C)) / (2 * A)
+            tdir = (math.cos(b), -math.sin(b))
+            vt = v0 * tdir[0] - g * s1 * tdir[1]
+            d = vt * 0.5 + 0.5 * g * math.sin(b) * 0.25
+            p1 = (v0 * s1, r - 0.5 * g * s1 * s1)
+            pts = [(-20.0, 0.0), (0.0, 0.0), (30 * math.cos(b), -30 * math.sin(b))]
+            if how == "walls":
+                geo = "".join(f"[[walls]]\nname = \"w{q}\"\nfrom = [{pts[q][0]!r}, {pts[q][1]!r}]\nto = [{pts[q + 1][0]!r}, {pts[q + 1][1]!r}]\nrestitution = 0.0\n" for q in range(2))
+            else:
+                geo = "[[surfaces]]\nname = \"track\"\npoints = [" + ", ".join(f"[{x!r}, {y!r}]" for x, y in pts) + "]\nrestitution = 0.0\n"
+            n = f"convex_{bdeg}_{v0}_{how}".replace(".", "p")
+            exact(n, f"""name = "{n}"
+duration = {1.0 / v0 + s1 + 0.5!r}
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+radius = {r}
+position = [-1.0, {r}]
+velocity = [{v0}, 0.0]
+restitution = 0.0
+{geo}""", [p1[0] + d * tdir[0], p1[1] + d * tdir[1]],
+                  [(vt + g * math.sin(b) * 0.5) * tdir[0], (vt + g * math.sin(b) * 0.5) * tdir[1]], 1e-7)
+
+# inclinebounce: a ball or a point dropped onto a 10-50 degree slope, e 0.3-1, mu 0-0.4:
+# the impact's Newton law with Coulomb friction (the tangential change mu (1 + e) |v_n| at
+# most, or all of it), then half its next flight. pointsettle: a point bouncing to rest.
+for deg in [10, 30, 50]:
+    for e in [0.3, 0.7, 1.0]:
+        for mu in [0.0, 0.1, 0.4]:
+            for shape in ["circle", "point"]:
+                th = math.radians(deg)
+                r = 0.3 if shape == "circle" else 0.0
+                t, nn = (math.cos(th), -math.sin(th)), (math.sin(th), math.cos(th))
+                p0 = (0.0, 2.0 + r / math.cos(th))
+                t1 = math.sqrt(2 * (nn[1] * p0[1] - r) / (g * math.cos(th)))
+                vn, vt = -g * t1 * nn[1], -g * t1 * t[1]
+                dvt = 0.0 if mu == 0 else (vt if vt <= mu * (1 + e) * -vn else min(mu * (1 + e) * -vn, vt))
+                v2 = (-e * vn * nn[0] + (vt - dvt) * t[0], -e * vn * nn[1] + (vt - dvt) * t[1])
+                s = -e * vn / (g * math.cos(th))
+                body = f"radius = {r}" if shape == "circle" else 'shape = "point"'
+                n = f"inclinebounce_{deg}_{e}_{mu}_{shape}".replace(".", "p")
+                exact(n, f"""name = "{n}"
+duration = {t1 + s!r}
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+{body}
+position = [0.0, {p0[1]!r}]
+restitution = {e}
+friction = {mu}
+[[walls]]
+name = "slope"
+from = [{-40 * t[0]!r}, {-40 * t[1]!r}]
+to = [{40 * t[0]!r}, {40 * t[1]!r}]
+restitution = {e}
+friction = {mu}
+""", [v2[0] * s, p0[1] - 0.5 * g * t1 * t1 + v2[1] * s - 0.5 * g * s * s], [v2[0], v2[1] - g * s], 1e-9)
+for h in [0.3, 2.0]:
+    for e in [0.0, 0.5, 0.9]:
+        for frac in [0.5, 1.4]:
+            T = frac * math.sqrt(2 * h / g) * (1 + e) / (1 - e)
+            y, vy = bounce_state(h, e, T)
+            n = f"pointsettle_{h}_{e}_{frac}".replace(".", "p")
+            exact(n, f"""name = "{n}"
+duration = {T!r}
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+shape = "point"
+position = [0.5, {h}]
+restitution = {e}
+[[walls]]
+name = "floor"
+from = [-5.0, 0.0]
+to = [5.0, 0.0]
+restitution = {e}
+""", [0.5, y], [0.0, vy], 1e-8)
+
+# box: a point or a 5 cm ball at 5-5000 m/s in a box of four walls (half-width 0.3-20 m),
+# e = 1, with and without gravity, along an axis, at 17 degrees, and into the corners.
+for v in [5, 50, 200, 1000, 5000]:
+    for size in [0.3, 2.0, 20.0]:
+        for ang in [0, 17, 45]:
+            for shape in ["circle", "point"]:
+                for grav in [0.0, 9.8]:
+                    a = math.radians(ang)
+                    body = f"radius = {min(0.05, size / 10)}" if shape == "circle" else 'shape = "point"'
+                    c = [(-size, -size), (size, -size), (size, size), (-size, size)]
+                    walls = "".join(f"""[[walls]]
+name = "w{k}"
+from = [{c[k][0]}, {c[k][1]}]
+to = [{c[(k + 1) % 4][0]}, {c[(k + 1) % 4][1]}]
+""" for k in range(4))
+                    n = f"box_{v}_{size}_{ang}_{shape}_{int(grav)}".replace(".", "p")
+                    write(n, f"""name = "{n}"
+duration = 2.0
+[world]
+gravity = [0.0, {-grav}]
+[[bodies]]
+name = "b"
+{body}
+position = [0.0, 0.0]
+velocity = [{v * math.cos(a)!r}, {v * math.sin(a)!r}]
+{walls}""")
+
+import json
+json.dump(truth, open(os.path.join(out, "..", "truth.json"), "w"))
 EOF
 
 mkdir -p "$work/refuse"
@@ -209,7 +601,7 @@ if [ "$status" -ge 2 ]; then cat "$work/run.txt" >&2; echo "hunt: physval run ex
 
 set +e
 python3 - "$work/out/results.json" "$work/scenes" <<'EOF'
-import json, math, re, sys
+import json, math, os, re, sys
 runs = json.load(open(sys.argv[1]))["runs"]
 found = []
 def green(r):
@@ -250,6 +642,52 @@ for r in runs:
         for c in misses:
             if c["pass"] and c["value"] is not None and c["value"] > 0.1 * c["limit"] / 1e-6:
                 found.append(f"WRONG GREEN {sc} {eng}: {c['what']} off by {c['value']:.3g} passed")
+truth = json.load(open(os.path.join(sys.argv[2], "..", "truth.json")))
+def ref_final(sc):
+    path = os.path.join(sys.argv[2], "..", "out", "series", sc, "reference.csv")
+    if not os.path.exists(path):
+        return None
+    rows = [l.strip().split(",") for l in open(path) if l.strip()]
+    d = dict(zip(rows[0], map(float, rows[-1])))
+    return [d["x_b"], d["y_b"]]
+refs = {x["scenario"]: x for x in json.load(open(sys.argv[1]))["references"]}
+for r in runs:
+    sc, eng = r["scenario"], r["engine"]
+    t = truth.get(sc)
+    if t is None or r["status"] in ("unsupported", "error"):
+        continue
+    f = [b for b in r["final"] if b["body"] == "b"][0]
+    err = max(math.dist(f["position"], t["position"]), math.dist(f["velocity"], t["velocity"]))
+    if eng == "core" and t["judge"] == "core" and err > t["tol"]:
+        found.append(f"CORE WRONG {sc}: {err:.3g} off its closed form (tolerance {t['tol']:.3g}), status {r['status']}")
+    if eng == "core" and t["judge"] == "reference":
+        ref = refs.get(sc, {})
+        p = ref_final(sc)
+        if ref.get("converged") and p is not None:
+            e = math.dist(p, t["position"])
+            if e > max(t["tol"], 10 * ref["convergence_error"]):
+                found.append(f"CORE WRONG {sc}: the converged reference is {e:.3g} m off the closed form "
+                             f"(convergence error {ref['convergence_error']:.3g})")
+    # Every engine: its position divergence from the reference must see its miss.
+    ref = refs.get(sc, {})
+    pd = r["metrics"].get("position_divergence")
+    p = ref_final(sc)
+    if eng != "core" and ref.get("converged") and pd is not None and p is not None:
+        miss = math.dist(f["position"], t["position"]) - math.dist(p, t["position"])
+        if pd < 0.5 * miss - 1e-9:
+            found.append(f"WRONG METRIC {sc} {eng}: ends {miss:.3g} m further from the closed form than the "
+                         f"reference, position_divergence {pd:.3g}")
+for r in runs:
+    sc, eng = r["scenario"], r["engine"]
+    if not sc.startswith("box_") or r["status"] in ("unsupported", "error"):
+        continue
+    half = float(sc.split("_")[2].replace("p", "."))
+    p = r["final"][0]["position"]
+    if max(abs(p[0]), abs(p[1])) > half + 1e-9:
+        if green(r):
+            found.append(f"WRONG GREEN {sc} {eng}: ended outside its box at {p}, status {r['status']}")
+        if eng == "core":
+            found.append(f"CORE WRONG {sc}: core left its box ({p})")
 for eng, by_width in drift.items():
     base = by_width.get(1)
     for w, d in sorted(by_width.items()):

@@ -154,8 +154,13 @@ std::string CoreEngine::broken_guarantee() const {
   if (w.unjustified_hold != core_detail::kNone) {
     std::ostringstream os;
     os << "core held body '" << w.name(w.unjustified_hold) << "' at t = " << w.unjustified_hold_time
-       << " s on bodies that, judged with it, cannot hold it (rigid Coulomb: they must spread); core has no "
-          "exact model of that collapse yet, so its path is not the physics (README, The hunt for wrong greens)";
+       << " s on bodies that, judged with it and every body at rest they touch (" << w.unjustified_component
+       << " bodies, faces fixed), "
+       << (w.unjustified_undecided ? "core could not show to hold it (rigid Coulomb, its solver did not converge: "
+                                   : "cannot hold it (rigid Coulomb: ")
+       << "a member is left " << w.unjustified_residual
+       << " m/s^2); core has no exact model of that collapse yet, so its path is not the physics (README, The hunt "
+          "for wrong greens)";
     return os.str();
   }
   if (!w.stats.event_cap_hit) return {};

@@ -280,7 +280,9 @@ class EventLoop {
       const toi::SegmentHit hit =
           toi::circle_segment(p, v, a, w_.radius[i], seg.from, seg.to, T_ - t, w_.length_scale, w_.force_acc(i));
       if (hit.s == toi::kNever || (k == own_face && !hit.cap)) continue;
-      push(Event::make(t + hit.s, i, k, w_.version[i], 0, EventKind::Static, hit.cap ? 1 : 0));
+      // A face's event carries the side it is met from (in b's unused version bits).
+      const std::uint32_t from_back = !hit.cap && dot(hit.normal, seg.normal) < 0.0 ? 1u : 0u;
+      push(Event::make(t + hit.s, i, k, w_.version[i], from_back, EventKind::Static, hit.cap ? 1 : 0));
     }
   }
 
@@ -552,7 +554,7 @@ class EventLoop {
     const double t_abs = ctx_.t0 + e.time;
     switch (e.kind()) {
       case EventKind::Pair: process_pair(e.a, e.b, e.time, t_abs); break;
-      case EventKind::Static: process_static(e.a, e.b, e.feature(), e.time, t_abs); break;
+      case EventKind::Static: process_static(e.a, e.b, e.feature(), e.time, t_abs, e.vb() != 0u); break;
       case EventKind::Stop: {
         // On the integrator's own path, which ends a sub-step (substeps.cpp).
         const double t = refine_stop(w_, e.a, e.time, w_.tloc[e.a], T_);
@@ -739,7 +741,8 @@ class EventLoop {
     }
   }
 
-  void process_static(std::uint32_t i, std::uint32_t k, std::uint8_t feature, double t, double t_abs) {
+  void process_static(std::uint32_t i, std::uint32_t k, std::uint8_t feature, double t, double t_abs,
+                      bool from_back) {
     const Segment& seg = w_.statics.segments[k];
     const PairResponse& r = w_.response(w_.group[i], seg.group);
     if (r.collide) {   // on the integrator's own path, which ends a sub-step (substeps.cpp)
@@ -759,13 +762,11 @@ class EventLoop {
     const bool face = feature == 0;
     Vec2 n;
     if (face) {
-      const double D = dot(p - seg.from, seg.normal);
-      const double tiny = 1e-9 * w_.radius[i] + 1e-15 * w_.length_scale;
-      double side;
-      if (D > tiny) side = 1.0;
-      else if (D < -tiny) side = -1.0;
-      else side = toi::line_side(0.0, dot(w_.vel[i], seg.normal), dot(w_.force_acc(i), seg.normal));
-      n = side * seg.normal;
+      // The side the face was met from, as the event was found (the root of that side's
+      // gap). Read from the position at impact instead, a point's side was the sign of a
+      // round-off: a point at 5000 m/s in a 4 m box met a wall at x = -2 - 4.4e-15, was
+      // taken as coming from outside, kept its velocity and left the box.
+      n = (from_back ? -1.0 : 1.0) * seg.normal;
     } else {
       const double u = dot(p - seg.from, seg.dir);
       const Vec2 q = u <= 0.0 ? seg.from : seg.to;
@@ -836,8 +837,12 @@ class EventLoop {
     if (w_.radius[i] == 0.0 && face) {
       // A point sits on the line at impact: keep it a hair on its own side, so that
       // the next face test knows which side it is on.
+      // Beyond the band in which the face test reads a point's side from its motion
+      // (toi::circle_segment: 8 eps x (coordinates + speed x step)).
       const double D = dot(w_.pos[i] - seg.from, n);
-      const double delta = 64.0 * 2.220446049250313e-16 * w_.length_scale;
+      const double coords = std::max(std::fabs(p.x), std::fabs(p.y)) + std::max(std::fabs(seg.from.x), std::fabs(seg.from.y));
+      const double delta = 2.220446049250313e-16 *
+                           std::max(64.0 * w_.length_scale, 32.0 * (coords + (length(w_.vel[i]) + length(w_.effective_acc(i)) * ctx_.dt) * ctx_.dt));
       if (D < delta) w_.pos[i] += (delta - D) * n;
     }
     if (r.event) record_contact(w_, i, kNone, &seg, t_abs, ctx_.dt);

@@ -357,7 +357,14 @@ bool leaning_group_holds(World& w, std::uint32_t i, std::span<const HeldContact>
       members.push_back(c.other);
     }
   }
-  if (members.size() == 1) return true;   // only fixed supports
+  if (members.size() == 1) {   // only fixed supports; those that are bodies brace it (`braced`)
+    if (braced != nullptr) {
+      for (const HeldContact& c : contacts) {
+        if (!(c.other & kBodySupport) && c.other < w.size() && w.dynamic(c.other)) *braced = true;
+      }
+    }
+    return true;
+  }
   const std::size_t n = w.size();
   // The bodies near a member: a scan (only groups that lean on bodies at rest get here).
   const auto near_of = [&](std::uint32_t m) {
@@ -399,7 +406,10 @@ bool leaning_group_holds(World& w, std::uint32_t i, std::span<const HeldContact>
     for (const HeldContact& c : tmp) {
       if (movable_along(c.other, c.n) && leans(m, c.n) && index_of(c.other) < 0) {
         members.push_back(c.other);
-        if (members.size() > kMaxLeaning) return true;   // too many to judge here
+        if (members.size() > kMaxLeaning) {   // too many to judge here
+          if (braced != nullptr) *braced = true;
+          return true;
+        }
       }
     }
   }
@@ -539,19 +549,19 @@ bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_
     held = false;
   }
   if (!held) return false;
-  // A free body held on bodies at rest on faces, which judged together with it cannot hold
-  // it, and no body outside that group touches them (a pyramid on a floor: nothing keeps the
-  // bottom balls from spreading): the old test holds it (the supports taken as fixed), and
-  // core has no exact model yet for the collapse. Held as before, but the run is no longer
-  // exact: reported as a broken guarantee (diverged), never `ok`. A group braced by another
-  // body is left to the old test: in a pile the group test takes every body outside it as
-  // fixed and found holds it could not justify that the braces may well justify (README,
-  // The hunt for wrong greens).
+  // A free body held on bodies at rest: the old test holds it (its supports taken as fixed).
+  // Judged with the bodies at rest on faces it leans on (the group test, frictionless faces
+  // included), the group may not hold it (a pyramid on a floor: nothing keeps the bottom balls
+  // from spreading), and core has no exact model yet for the collapse; or another body touches
+  // the group (`braced`: a brace, a held body, a body on a body), and the group test, taking it
+  // as fixed, cannot decide. Either way it is held as before and judged once the supports of
+  // the step are settled, on its whole resting component (judge_braced_holds: the bodies held
+  // later in the same pass brace it too); if that cannot hold it, the run is no longer exact:
+  // a broken guarantee (diverged), never `ok`.
   bool braced = false;
-  if (!on_face && w.unjustified_hold == kNone && !leaning_group_holds(w, i, contacts, mu, true, &braced) &&
-      !braced) {
-    w.unjustified_hold = i;
-    w.unjustified_hold_time = w.time;
+  if (!on_face && w.unjustified_hold == kNone && (!leaning_group_holds(w, i, contacts, mu, true, &braced) || braced) &&
+      std::find(w.braced_holds.begin(), w.braced_holds.end(), i) == w.braced_holds.end()) {
+    w.braced_holds.push_back(i);
   }
   release_support(w, i);
   w.vel[i] = {};
@@ -881,6 +891,321 @@ bool try_hold_group_pocket(World& w, std::uint32_t seed, double t, double dt, co
   return true;
 }
 
+namespace {
+
+// The bodies near a member of a resting component: every live body, sorted by x, so that
+// those that may touch a member are a window.
+struct BodiesByX {
+  std::vector<std::uint32_t> order;
+  double rmax = 0.0;
+  void build(const World& w) {
+    order.clear();
+    rmax = 0.0;
+    for (std::uint32_t j = 0; j < w.size(); ++j) {
+      if (w.alive(j)) {
+        order.push_back(j);
+        rmax = std::max(rmax, w.radius[j]);
+      }
+    }
+    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+      return w.pos[a].x < w.pos[b].x || (w.pos[a].x == w.pos[b].x && a < b);
+    });
+  }
+  // The bodies touching body m (as touching_supports: within 1e-9 of contact), that may
+  // collide with it; out gets (body, unit normal from it towards m).
+  void touching(const World& w, std::uint32_t m, std::vector<std::pair<std::uint32_t, Vec2>>& out) const {
+    out.clear();
+    const double reach = w.radius[m] + rmax + 1e-9 * (w.radius[m] + rmax + w.length_scale);
+    auto it = std::lower_bound(order.begin(), order.end(), w.pos[m].x - reach,
+                               [&](std::uint32_t a, double x) { return w.pos[a].x < x; });
+    for (; it != order.end() && w.pos[*it].x <= w.pos[m].x + reach; ++it) {
+      const std::uint32_t j = *it;
+      if (j == m || std::fabs(w.pos[j].y - w.pos[m].y) > reach) continue;
+      if ((w.flags[m] & kPoint) && (w.flags[j] & kPoint)) continue;
+      if (((w.flags[m] | w.flags[j]) & kParticle) && related_bodies(w, m, j)) continue;
+      if (w.any_rules && !w.response(w.group[m], w.group[j]).collide) continue;
+      const Vec2 d = w.pos[m] - w.pos[j];
+      const double dist = length(d);
+      const double R = w.radius[m] + w.radius[j];
+      if (!(dist > 0.0) || std::fabs(dist - R) > 1e-9 * (R + w.length_scale)) continue;
+      out.push_back({j, d / dist});
+    }
+  }
+};
+
+// The resting component of body `seed`: the dynamic bodies that touch it, and those that
+// touch them in turn, all at rest or slow (|v| <= the rest speed of their force, as core
+// holds bodies: a body micro-bouncing on the group presses on it); static bodies and faces
+// are fixed. Sorted. False when a faster body touches a member: the component is being
+// struck, not at rest, and is not judged now.
+bool resting_component(World& w, const BodiesByX& bx, std::uint32_t seed, std::vector<std::uint32_t>& members) {
+  thread_local std::vector<std::pair<std::uint32_t, Vec2>> touch;
+  members.assign(1, seed);
+  for (std::size_t q = 0; q < members.size(); ++q) {
+    bx.touching(w, members[q], touch);
+    for (const auto& [j, nrm] : touch) {
+      if (!w.dynamic(j) || std::find(members.begin(), members.end(), j) != members.end()) continue;
+      if (!w.stationary(j) && length(w.vel[j]) > w.rest_speed(length(w.acc[j]), w.step_dt)) return false;
+      members.push_back(j);
+    }
+  }
+  std::sort(members.begin(), members.end());
+  return true;
+}
+
+// Whether a resting component (sorted members; faces and static bodies fixed) can be held
+// by rigid Coulomb contact: a normal force >= 0 at every contact and a static friction
+// force within mu times it, every member's acceleration zero. The tolerances of
+// leaning_group_holds (held iff every member ends with |a| <= 1e-9 of its force
+// acceleration; Gauss-Seidel stops at 1e-14 of the largest, or after 20000 sweeps), with no
+// member taken as fixed. kCannotHold only with a certificate (below), else kUndecided.
+// `residual`: the largest acceleration left on a member by Gauss-Seidel.
+enum class Verdict { kHeld, kCannotHold, kUndecided };
+
+Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint32_t> members, double& residual) {
+  thread_local std::vector<std::pair<std::uint32_t, Vec2>> touch;
+  thread_local std::vector<HeldContact> faces;
+  thread_local std::vector<double> mus;
+  const std::size_t M = members.size();
+  // One column per edge of each contact's static friction cone (n +- mu t; n alone when
+  // frictionless): a force >= 0 along each. In 2D the two edges span the Coulomb cone
+  // exactly, so the members can be held iff some forces >= 0 cancel every member's force:
+  // a convex problem (least squares with non-negative forces), whose projected Gauss-Seidel
+  // (coordinate descent) converges to its minimum: zero iff held.
+  struct Col {
+    std::int32_t a, b;   // member indices; a = -1: a fixed support
+    Vec2 d;              // the force on b per unit (on a: minus it)
+    double height;       // of the contact, along the members' mean force (for the order)
+  };
+  thread_local std::vector<Col> cols;
+  cols.clear();
+  Vec2 down{};
+  for (std::size_t q = 0; q < M; ++q) down += w.acc[members[q]];
+  const auto add = [&](std::int32_t a, std::int32_t b, Vec2 nrm, double m, Vec2 at) {
+    const double h = -dot(at, down);
+    if (m > 0.0) {
+      cols.push_back({a, b, nrm + m * perp(nrm), h});
+      cols.push_back({a, b, nrm - m * perp(nrm), h});
+    } else {
+      cols.push_back({a, b, nrm, h});
+    }
+  };
+  for (std::size_t q = 0; q < M; ++q) {
+    const std::uint32_t m = members[q];
+    const auto b = static_cast<std::int32_t>(q);
+    faces.clear();
+    mus.clear();
+    touching_supports(w, m, {}, faces, mus);   // its faces
+    for (std::size_t k = 0; k < faces.size(); ++k) add(-1, b, faces[k].n, mus[k], w.pos[m] - w.radius[m] * faces[k].n);
+    bx.touching(w, m, touch);
+    for (const auto& [j, nrm] : touch) {
+      const double mu = holding_coefficient(w.pair_material(w.material[m], w.material[j]));
+      const Vec2 at = w.pos[m] - w.radius[m] * nrm;
+      if (!w.dynamic(j)) {
+        add(-1, b, nrm, mu, at);
+        continue;
+      }
+      const auto it = std::lower_bound(members.begin(), members.end(), j);
+      if (it == members.end() || *it != j) continue;   // not possible: members are closed under touching
+      const auto o = static_cast<std::int32_t>(it - members.begin());
+      if (o < b) continue;   // the pair's column is there already
+      add(o, b, nrm, mu, at);
+    }
+  }
+  // Highest contacts first: a load is passed down a column in one sweep, not one contact a
+  // sweep (a column of 50 balls reached only 3e-8 of g in 20000 sweeps in index order).
+  std::stable_sort(cols.begin(), cols.end(), [](const Col& x, const Col& y) { return x.height > y.height; });
+  thread_local std::vector<Vec2> acc;
+  thread_local std::vector<double> lam, Akk;
+  acc.resize(M);
+  for (std::size_t q = 0; q < M; ++q) acc[q] = w.acc[members[q]];
+  const auto inv = [&](std::int32_t x) { return x < 0 ? 0.0 : w.inv_mass[members[static_cast<std::size_t>(x)]]; };
+  const std::size_t C = cols.size();
+  lam.assign(C, 0.0);
+  Akk.resize(C);
+  for (std::size_t k = 0; k < C; ++k) Akk[k] = (inv(cols[k].a) + inv(cols[k].b)) * length_squared(cols[k].d);
+  double amax = 0.0;
+  for (std::size_t q = 0; q < M; ++q) amax = std::max(amax, length(acc[q]));
+  bool converged = false;
+  for (int iter = 0; iter < 20000 && !converged; ++iter) {
+    double change = 0.0;
+    for (std::size_t x = 0; x < C; ++x) {   // forward, then backward (symmetric Gauss-Seidel)
+      const std::size_t k = (iter & 1) ? C - 1 - x : x;
+      const Col& c = cols[k];
+      if (!(Akk[k] > 0.0)) continue;
+      const Vec2 ab = acc[static_cast<std::size_t>(c.b)];
+      const Vec2 aa = c.a < 0 ? Vec2{} : acc[static_cast<std::size_t>(c.a)];
+      const double l = projected_row(lam[k], dot(ab - aa, c.d), Akk[k], false, 0.0);
+      const double dl = l - lam[k];
+      if (dl == 0.0) continue;
+      lam[k] = l;
+      if (c.a >= 0) acc[static_cast<std::size_t>(c.a)] -= (dl * inv(c.a)) * c.d;
+      acc[static_cast<std::size_t>(c.b)] += (dl * inv(c.b)) * c.d;
+      change = std::max(change, std::fabs(dl) * Akk[k]);
+    }
+    converged = change <= 1e-14 * amax;
+  }
+  // At rest: within 1e-9 of its force acceleration, or within the round-off of summing its
+  // contact forces (64 eps x their sum over its mass). Without the latter a ball of 1 kg
+  // under one of 1e9 kg in a column (held exactly) was never "at rest": 1e-9 of g is 1e-19
+  // of the forces on it, and the run was reported as a hold core could not show.
+  thread_local std::vector<double> force_sum;
+  const auto all_at_rest = [&](std::span<const Vec2> a, std::span<const double> l) {
+    force_sum.assign(M, 0.0);
+    for (std::size_t k = 0; k < C; ++k) {
+      const double f = std::fabs(l[k]) * length(cols[k].d);
+      if (cols[k].a >= 0) force_sum[static_cast<std::size_t>(cols[k].a)] += f * inv(cols[k].a);
+      force_sum[static_cast<std::size_t>(cols[k].b)] += f * inv(cols[k].b);
+    }
+    for (std::size_t q = 0; q < M; ++q) {
+      if (length(a[q]) > 1e-9 * length(w.acc[members[q]]) + 64.0 * 2.220446049250313e-16 * force_sum[q]) return false;
+    }
+    return true;
+  };
+  bool held = all_at_rest(acc, lam);
+  residual = 0.0;
+  for (std::size_t q = 0; q < M; ++q) residual = std::max(residual, length(acc[q]));
+  for (int pass = 0; pass < 2 && !held; ++pass) {
+    // Gauss-Seidel crawls along long chains (a column of 50 balls: its rate is 1 - (pi /
+    // 101)^2 a sweep). Polish: keep the contacts it loads, and solve for the corrections to
+    // their forces that cancel the rest exactly (least squares by conjugate gradients, CGLS,
+    // in mass-weighted form: the member's sqrt(m) a). Held iff every corrected force is
+    // still >= 0 and, summed afresh, leaves every member at rest within the same 1e-9.
+    // A second pass takes every contact: with masses 1e9 apart Gauss-Seidel had not loaded
+    // some contacts a column needs at all (a step moves the light member 1e9 times more
+    // than the heavy one), and the polish over the loaded ones could not reach rest.
+    thread_local std::vector<std::size_t> act;
+    thread_local std::vector<double> x, pdir, sv, lam2;
+    thread_local std::vector<Vec2> res, qv, acc2;
+    act.clear();
+    for (std::size_t k = 0; k < C; ++k) {
+      if (pass == 1 || lam[k] > 0.0) act.push_back(k);
+    }
+    const std::size_t P = act.size();
+    const auto sq = [&](std::int32_t m) { return std::sqrt(inv(m)); };
+    const auto apply = [&](std::span<const double> v, std::vector<Vec2>& out) {   // out = B v
+      out.assign(M, Vec2{});
+      for (std::size_t z = 0; z < P; ++z) {
+        const Col& c = cols[act[z]];
+        if (c.a >= 0) out[static_cast<std::size_t>(c.a)] -= (v[z] * sq(c.a)) * c.d;
+        out[static_cast<std::size_t>(c.b)] += (v[z] * sq(c.b)) * c.d;
+      }
+    };
+    const auto apply_t = [&](std::span<const Vec2> r, std::vector<double>& out) {   // out = B^T r
+      out.resize(P);
+      for (std::size_t z = 0; z < P; ++z) {
+        const Col& c = cols[act[z]];
+        double v = sq(c.b) * dot(c.d, r[static_cast<std::size_t>(c.b)]);
+        if (c.a >= 0) v -= sq(c.a) * dot(c.d, r[static_cast<std::size_t>(c.a)]);
+        out[z] = v;
+      }
+    };
+    res.resize(M);
+    for (std::size_t q = 0; q < M; ++q) res[q] = (-1.0 / sq(static_cast<std::int32_t>(q))) * acc[q];   // -sqrt(m) a
+    x.assign(P, 0.0);
+    apply_t(res, sv);
+    pdir = sv;
+    double gamma = 0.0;
+    for (double v : sv) gamma += v * v;
+    const double gamma0 = gamma;
+    for (std::size_t it = 0; it < 4 * P + 100 && gamma > 1e-32 * gamma0; ++it) {
+      apply(pdir, qv);
+      double qq = 0.0;
+      for (const Vec2& v : qv) qq += length_squared(v);
+      if (!(qq > 0.0)) break;
+      const double alpha = gamma / qq;
+      for (std::size_t z = 0; z < P; ++z) x[z] += alpha * pdir[z];
+      for (std::size_t q = 0; q < M; ++q) res[q] -= alpha * qv[q];
+      apply_t(res, sv);
+      double gn = 0.0;
+      for (double v : sv) gn += v * v;
+      const double beta = gn / gamma;
+      for (std::size_t z = 0; z < P; ++z) pdir[z] = sv[z] + beta * pdir[z];
+      gamma = gn;
+    }
+    lam2 = lam;
+    bool nonneg = true;
+    for (std::size_t z = 0; z < P; ++z) {
+      lam2[act[z]] += x[z];
+      if (lam2[act[z]] < 0.0) nonneg = false;
+    }
+    if (nonneg) {
+      acc2.resize(M);
+      for (std::size_t q = 0; q < M; ++q) acc2[q] = w.acc[members[q]];
+      for (std::size_t k = 0; k < C; ++k) {
+        const Col& c = cols[k];
+        if (lam2[k] == 0.0) continue;
+        if (c.a >= 0) acc2[static_cast<std::size_t>(c.a)] -= (lam2[k] * inv(c.a)) * c.d;
+        acc2[static_cast<std::size_t>(c.b)] += (lam2[k] * inv(c.b)) * c.d;
+      }
+      held = all_at_rest(acc2, lam2);
+    }
+  }
+  if (held) return Verdict::kHeld;
+  // Not held: the accelerations left are a certificate (Farkas) if they violate no contact:
+  // every cone edge's relative acceleration along it >= 0 (to round-off, 1e-12 of the largest
+  // force acceleration) while the forces do positive work along them (they are the least
+  // mass-weighted residual, so their work is its square): a motion the contacts allow and
+  // the forces drive. Else Gauss-Seidel has not converged and nothing is certain.
+  double worst = INFINITY;
+  for (std::size_t k = 0; k < C; ++k) {
+    const Col& c = cols[k];
+    const Vec2 aa = c.a < 0 ? Vec2{} : acc[static_cast<std::size_t>(c.a)];
+    worst = std::min(worst, dot(acc[static_cast<std::size_t>(c.b)] - aa, c.d) / length(c.d));
+  }
+  double work = 0.0;
+  for (std::size_t q = 0; q < M; ++q) work += dot(w.acc[members[q]], acc[q]) / inv(static_cast<std::int32_t>(q));
+  return worst >= -1e-12 * amax && work > 0.0 ? Verdict::kCannotHold : Verdict::kUndecided;
+}
+
+}  // namespace
+
+// The free bodies try_hold held this step on a group that other bodies brace, still held
+// once the step's supports are settled: each judged on its resting component
+// (component_holds). A component that cannot hold is a broken guarantee, as an unbraced
+// group is in try_hold. Components found able to hold are remembered (members, positions
+// and force accelerations, bit for bit): a settled pile is solved once.
+void judge_braced_holds(World& w) {
+  if (w.braced_holds.empty()) return;
+  thread_local BodiesByX bx;
+  thread_local std::vector<std::uint32_t> members, judged;
+  thread_local World::JudgedComponent key;
+  judged.clear();
+  bool built = false;
+  for (std::uint32_t i : w.braced_holds) {
+    if (w.unjustified_hold != kNone) break;
+    if (!w.alive(i) || !w.is_held(i)) continue;   // core moved it: not a hold any more
+    if (std::find(judged.begin(), judged.end(), i) != judged.end()) continue;   // its component is judged
+    if (!built) {
+      bx.build(w);
+      built = true;
+    }
+    if (!resting_component(w, bx, i, members)) continue;   // struck: judged again next step if still held
+    judged.insert(judged.end(), members.begin(), members.end());
+    key.members = members;
+    key.state.clear();
+    for (std::uint32_t m : members) {
+      key.state.push_back(w.pos[m]);
+      key.state.push_back(w.acc[m]);
+    }
+    const auto same = [&](const World::JudgedComponent& c) { return c.members == key.members && c.state == key.state; };
+    if (std::any_of(w.justified_components.begin(), w.justified_components.end(), same)) continue;
+    double residual = 0.0;
+    const Verdict v = component_holds(w, bx, members, residual);
+    if (v == Verdict::kHeld) {
+      if (w.justified_components.size() >= 8) w.justified_components.erase(w.justified_components.begin());
+      w.justified_components.push_back(key);
+      continue;
+    }
+    w.unjustified_hold = i;
+    w.unjustified_hold_time = w.time;
+    w.unjustified_component = members.size();
+    w.unjustified_residual = residual;
+    w.unjustified_undecided = v == Verdict::kUndecided;
+  }
+  w.braced_holds.clear();
+}
+
 bool hold_wedged(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near) {
   if (!w.dynamic(i) || w.is_held(i) || w.acc.empty()) return false;
   const double amag = length(w.acc[i]);
@@ -1204,6 +1529,7 @@ void push_trains(World& w) {
 
 void apply_supports(World& w, const StepContext& ctx) {
   w.step_dt = ctx.dt;
+  w.braced_holds.clear();   // holds of the last step are judged again by hold_pass
   const std::size_t n = w.size();
   for (std::uint32_t i = 0; i < n; ++i) {
     if (w.support[i] == kNone) {
@@ -1259,6 +1585,7 @@ void apply_supports(World& w, const StepContext& ctx) {
     }
     if (hold_pass(w, ctx)) changed = true;
   }
+  judge_braced_holds(w);
   if (!w.varying_forces) push_trains(w);
 }
 

@@ -235,6 +235,25 @@ struct World {
   // collapse that follows, so the run reports a broken guarantee (try_hold).
   std::uint32_t unjustified_hold = kNone;
   double unjustified_hold_time = -1.0;
+  // Judged on its whole resting component (every body at rest transitively touching it,
+  // faces and static bodies fixed): its size, and the largest acceleration left on a member
+  // (m/s^2).
+  std::size_t unjustified_component = 0;
+  double unjustified_residual = 0.0;
+  // Whether that judgement was left undecided (Gauss-Seidel did not converge and no
+  // certificate that the component must move was found): reported all the same.
+  bool unjustified_undecided = false;
+  // Free bodies held by try_hold whose group test cannot justify the hold (it fails, or bodies
+  // outside the group brace it): judged at the end of apply_supports on their resting
+  // component (judge_braced_holds, resting_contact.cpp).
+  std::vector<std::uint32_t> braced_holds;
+  // Components found able to hold (members sorted, then their positions and force
+  // accelerations, bit for bit): a settled pile is solved once, not every step.
+  struct JudgedComponent {
+    std::vector<std::uint32_t> members;
+    std::vector<Vec2> state;
+  };
+  std::vector<JudgedComponent> justified_components;
   std::int64_t max_events_seen = 0;
 
   // ---- helpers

@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <numbers>
+#include <string>
 
 #include "physval/core/scene_builders.hpp"
 #include "scene_fixture.hpp"
@@ -237,6 +239,9 @@ struct PileCase {
   double e;
   std::uint64_t seed;
   double mu = 0.5;
+  // Why core is expected to hold something there that rigid Coulomb cannot (README, The hunt
+  // for wrong greens); nullptr: it must settle within its model.
+  const char* beyond = nullptr;
 };
 
 class CorePileSettles : public ::testing::TestWithParam<PileCase> {};
@@ -259,20 +264,23 @@ TEST_P(CorePileSettles, SettlesWithoutOverlapCapOrEnergyGain) {
   double E_prev = INFINITY;
   double worst_rise = 0.0;
   std::int64_t last_events = -1;
+  std::string beyond;
   // 30 s: most piles are at rest within 1 s; the slowest here (100 circles at e = 0.6)
   // keeps a few bodies micro-bouncing until about 29 s (README, Known limits).
   const int steps = 1800;
   for (int k = 0; k < steps; ++k) {
     sim.step(dt);
-    // A hold core cannot justify (a ball wedged between a wall and a floor ball that rigid
-    // Coulomb sets sliding) is reported, not hidden: the pile is then beyond core's model and
-    // its run is diverged, which is what a user sees. Listed as skipped with the reason (n10,
-    // e 0.9, seed 3: p3 between the right wall and p2 at t = 1 s, the group test gives p3
-    // 0.75 m/s^2 down and p2 0.10 m/s^2 sideways); the event cap stays a failure.
-    if (const std::string b = sim.engine.broken_guarantee(); b.find("cannot hold it") != std::string::npos) {
-      GTEST_SKIP() << "beyond core's model at step " << k << ": " << b;
+    ASSERT_FALSE(sim.engine.last_step_stats().event_cap_hit) << "step " << k;
+    // A hold core cannot justify (its resting component, judged by rigid Coulomb, must move)
+    // is reported, not hidden: the pile is then beyond core's model and its run is diverged,
+    // which is what a user sees. Only where the case says so (PileCase::beyond, with the
+    // reason), and only with rigid Coulomb's certificate ("cannot hold it", not "could not
+    // show"); everything else below is asserted all the same (core's path is not the
+    // physics then, but it must still never overlap, gain energy or hit the event cap).
+    if (const std::string b = sim.engine.broken_guarantee(); !b.empty() && beyond.empty()) {
+      ASSERT_NE(b.find("cannot hold it"), std::string::npos) << "step " << k << ": " << b;
+      beyond = b;
     }
-    ASSERT_TRUE(sim.engine.broken_guarantee().empty()) << "step " << k << ": " << sim.engine.broken_guarantee();
     sim.engine.read_states(sim.states);
     const double E = energy(sim.states, sim.scene);
     if (k > 0) worst_rise = std::max(worst_rise, E - E_prev);
@@ -289,13 +297,33 @@ TEST_P(CorePileSettles, SettlesWithoutOverlapCapOrEnergyGain) {
   for (const BodyState& s : sim.states) EXPECT_EQ(s.velocity, Vec2{});
   EXPECT_TRUE(sim.engine.limits_hit().empty());
   RecordProperty("worst_energy_rise_J", std::to_string(worst_rise));
+  if (c.beyond == nullptr) {
+    EXPECT_EQ(beyond, "") << "a hold core cannot justify in a pile expected to settle within its model";
+  } else {
+    RecordProperty("beyond_core_model", beyond);
+    if (beyond.empty()) std::cout << "note: no longer reported beyond core's model (" << c.beyond << ")\n";
+  }
 }
 
+// Every pile but two holds, while it settles, a group its resting component cannot hold by
+// rigid Coulomb (judge_braced_holds; each checked by an independent linear program, HiGHS:
+// no forces within the friction cones balance the weights, the least relative residual 0.9% to
+// 30% of them): the run is diverged from then on. The body, time, component size and the
+// acceleration left on a member (the first report, at main 373ff33 + this check):
+constexpr const char* kLeaning = "a leaning group core holds as if its supports were fixed";
 INSTANTIATE_TEST_SUITE_P(Piles, CorePileSettles,
-                         ::testing::Values(PileCase{10, 0.3, 1}, PileCase{10, 0.0, 2}, PileCase{10, 0.9, 3},
-                                           PileCase{50, 0.3, 1}, PileCase{50, 0.0, 2}, PileCase{50, 0.9, 3},
-                                           PileCase{50, 0.5, 4}, PileCase{100, 0.3, 5}, PileCase{100, 0.6, 6},
-                                           PileCase{200, 0.3, 7}),
+                         ::testing::Values(PileCase{10, 0.3, 1}, PileCase{10, 0.0, 2},
+                                           // p2 at 1.02 s: p3 wedged between the right wall and p2,
+                                           // which slides out (2 bodies, 0.36 m/s^2)
+                                           PileCase{10, 0.9, 3, 0.5, kLeaning},
+                                           // p0 at 0.5 s: a leaning tower p3-p10-p17-p24-p31 (42, 0.15)
+                                           PileCase{50, 0.3, 1, 0.5, kLeaning},
+                                           PileCase{50, 0.0, 2, 0.5, kLeaning},   // p0 at 0.48 s (22, 0.59)
+                                           PileCase{50, 0.9, 3, 0.5, kLeaning},   // p0 at 0.68 s (45, 1.29)
+                                           PileCase{50, 0.5, 4, 0.5, kLeaning},   // p2 at 0.32 s (14, 1.04)
+                                           PileCase{100, 0.3, 5, 0.5, kLeaning},  // p0 at 0.45 s (16, 3.9)
+                                           PileCase{100, 0.6, 6, 0.5, kLeaning},  // p1 at 0.43 s (31, 5.7)
+                                           PileCase{200, 0.3, 7, 0.5, kLeaning}), // p6 at 0.3 s (20, 1.96)
                          [](const auto& test_info) {
                            return "n" + std::to_string(test_info.param.n) + "_e" +
                                   std::to_string(static_cast<int>(test_info.param.e * 10)) + "_seed" +
@@ -307,10 +335,18 @@ INSTANTIATE_TEST_SUITE_P(Piles, CorePileSettles,
 // hops; they reached the event cap until a body falling into a slot between two held
 // ones, and two circles sliding side by side, stopped being read as impacts at one
 // instant for ever (exact_collisions.cpp). Same assertions as with friction.
+// All six hold a body wedged on bodies that a frictionless floor lets slide (reported as
+// above): p3 at 0.52 s between the right wall and p3's floor ball, 2.6e-7 m from its neighbour
+// and 0.028 m of free row behind (2 bodies, 7.2 m/s^2); p0 at 0.75 s, p8 on p0 leaning 3.2e-8
+// rad, p0 pushed off the wall at 3.2e-7 m/s^2 (2 bodies; rigid Coulomb at 1e-9, the group
+// test's tolerance); p1 at 0.88 s (5, 9.8: a ball wedged 3e-4 m above the floor between two
+// that can spread 5e-7 m); p1 at 1.95 s (4, 9.8); p0 at 0.48 s (9, 4.0: p6 on p2 and p7, p2
+// free to slide left); p2 at 0.8 s (3, 2.19).
+constexpr const char* kWedged = "a ball wedged on balls a frictionless floor lets slide";
 INSTANTIATE_TEST_SUITE_P(FrictionlessPiles, CorePileSettles,
-                         ::testing::Values(PileCase{10, 0.0, 1, 0.0}, PileCase{10, 0.3, 1, 0.0},
-                                           PileCase{10, 0.6, 1, 0.0}, PileCase{10, 0.9, 1, 0.0},
-                                           PileCase{10, 0.3, 2, 0.0}, PileCase{10, 0.3, 3, 0.0}),
+                         ::testing::Values(PileCase{10, 0.0, 1, 0.0, kWedged}, PileCase{10, 0.3, 1, 0.0, kWedged},
+                                           PileCase{10, 0.6, 1, 0.0, kWedged}, PileCase{10, 0.9, 1, 0.0, kWedged},
+                                           PileCase{10, 0.3, 2, 0.0, kWedged}, PileCase{10, 0.3, 3, 0.0, kWedged}),
                          [](const auto& test_info) {
                            return "n" + std::to_string(test_info.param.n) + "_e" +
                                   std::to_string(static_cast<int>(test_info.param.e * 10)) + "_seed" +

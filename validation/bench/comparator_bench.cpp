@@ -2,11 +2,13 @@
 // with `range(0)` contact events per run, bodies and samples of a 1k-body scene).
 #include <benchmark/benchmark.h>
 
+#include <charconv>
 #include <cmath>
 #include <random>
 
 #include "physval/validation/comparator.hpp"
 #include "../src/containment.hpp"
+#include "../src/number_text.hpp"
 
 namespace physval {
 namespace {
@@ -97,7 +99,7 @@ void BM_ContainmentObserveGas(benchmark::State& state) {
   const Vec2 c[4] = {{-half, -half}, {half, -half}, {half, half}, {-half, half}};
   for (int k = 0; k < 4; ++k) {
     WallDef w;
-    w.name = "w" + std::to_string(k);
+    w.name = std::string("w").append(std::to_string(k));
     w.from = c[k];
     w.to = c[(k + 1) % 4];
     scene.walls.push_back(w);
@@ -107,7 +109,7 @@ void BM_ContainmentObserveGas(benchmark::State& state) {
   std::vector<BodyState> states(n);
   for (std::size_t i = 0; i < n; ++i) {
     BodyDef b;
-    b.name = "c" + std::to_string(i);
+    b.name = std::string("c").append(std::to_string(i));
     b.radius = 0.05;
     b.position = {static_cast<double>(i % side) * spacing - half + 0.1 + spacing / 2.0,
                   static_cast<double>(i / side) * spacing - half + 0.1 + spacing / 2.0};
@@ -135,6 +137,31 @@ void BM_ContainmentObserveGas(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n));
 }
 BENCHMARK(BM_ContainmentObserveGas)->Arg(200)->Arg(1000)->Unit(benchmark::kMicrosecond);
+
+
+// The series CSVs' number text (results_json.cpp writes six CSVs of up to 807 columns a
+// sample; on circle_gas that was a third of the harness): 4096 positions of a gas (full
+// 17-digit doubles in +-3.5 m, a few energies and momenta), each as %.12g and a comma.
+// range(0) = 0: std::to_chars(general, 12); 1: to_chars_g12 (the same bytes).
+void BM_SeriesNumberText(benchmark::State& state) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> position(-3.5, 3.5), energy(10.0, 200.0);
+  std::vector<double> values(4096);
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = i % 64 == 0 ? energy(rng) : position(rng);
+  std::vector<char> buffer(values.size() * 33);
+  const bool fast = state.range(0) == 1;
+  for (auto _ : state) {
+    char* o = buffer.data();
+    for (const double v : values) {
+      o = fast ? to_chars_g12(o, o + 32, v) : std::to_chars(o, o + 32, v, std::chars_format::general, 12).ptr;
+      *o++ = ',';
+    }
+    benchmark::DoNotOptimize(o);
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(values.size()));
+}
+BENCHMARK(BM_SeriesNumberText)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace physval

@@ -10,6 +10,7 @@ namespace physval {
 namespace {
 
 constexpr std::size_t kBruteForceBarriers = 16;
+constexpr std::size_t kMinStripBodies = 32;   // fewer: the plain sweep
 constexpr double kMaxCellsPerBarrier = 4096.0;
 
 std::int64_t cell_index(double x, double inv) {
@@ -266,6 +267,61 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
     const double y0 = before(i).y, y1 = pos_[i].y;
     sorted_y_[p] = alive_[i] ? YRange{std::min(y0, y1), std::max(y0, y1)} : YRange{kNaN, kNaN};
   }
+  // Horizontal strips, when the order is a clean sort (every left end finite, so the sweep
+  // below stops for each body exactly at the first box starting after its own ends): a
+  // strip is at least as tall as the y filter below can reach (the radii together, the
+  // largest y swept over the step) plus a margin, so every pair the filter can pass has its
+  // bodies' swept y intervals starting in the same strip or in neighbouring ones. Each
+  // body then scans its own strip and the two beside it, where the whole sweep scanned
+  // every body in its x range (in a 1k-body gas about 17, of which one or two pass).
+  std::uint32_t strips = 0;
+  bool use_strips = !plain_sweep_ && n >= kMinStripBodies;
+  if (use_strips) {
+    double ymin = std::numeric_limits<double>::infinity(), ymax = -ymin, swept = 0.0;
+    bool clean = true;
+    for (std::size_t p = 0; p < n; ++p) {
+      clean = clean && std::isfinite(sorted_lo_[p]);
+      const YRange y = sorted_y_[p];
+      if (y.lo == y.lo) {   // alive
+        ymin = std::min(ymin, y.lo);
+        ymax = std::max(ymax, y.lo);
+        swept = std::max(swept, y.hi - y.lo);
+      }
+    }
+    const double span = ymax - ymin;
+    double height = (2.0 * max_radius_ * (1.0 + 1e-9) + swept) * 1.01 + 1e-9 * (std::fabs(ymin) + std::fabs(ymax));
+    if (clean && std::isfinite(span) && std::isfinite(height) && height > 0.0) {
+      height = std::max(height, span / static_cast<double>(n) * 1.01);   // at most about n strips
+      const double inv = 1.0 / height;
+      strips = static_cast<std::uint32_t>(span * inv) + 1;
+      strip_start_.assign(static_cast<std::size_t>(strips) + 1, 0);
+      strip_of_.resize(n);
+      for (std::size_t p = 0; p < n; ++p) {
+        const YRange y = sorted_y_[p];
+        if (y.lo != y.lo) continue;   // not alive: in no strip, never anyone's neighbour
+        const auto s = std::min(static_cast<std::uint32_t>((y.lo - ymin) * inv), strips - 1);
+        strip_of_[p] = s;
+        ++strip_start_[s + 1];
+      }
+      for (std::uint32_t s = 0; s < strips; ++s) strip_start_[s + 1] += strip_start_[s];
+      strip_cursor_.assign(strip_start_.begin(), strip_start_.end() - 1);
+      const std::size_t members = strip_start_[strips];
+      strip_item_.resize(members);
+      strip_lo_.resize(members);
+      strip_y_.resize(members);
+      for (std::size_t p = 0; p < n; ++p) {   // in x order: each strip's members stay sorted
+        const YRange y = sorted_y_[p];
+        if (y.lo != y.lo) continue;
+        const std::uint32_t c = strip_cursor_[strip_of_[p]]++;
+        strip_item_[c] = static_cast<std::uint32_t>(p);
+        strip_lo_[c] = sorted_lo_[p];
+        strip_y_[c] = y;
+      }
+      strip_cursor_.assign(strip_start_.begin(), strip_start_.end() - 1);
+    } else {
+      use_strips = false;
+    }
+  }
   for (std::size_t p = 0; p < n; ++p) {
     const std::size_t i = order_[p];
     if (!alive_[i]) continue;
@@ -283,9 +339,30 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
     const double reach = (ri + max_radius_) * (1.0 + 1e-9);
     const double y_lo = ylo - reach, y_hi = yhi + reach;
     std::size_t found = 0;
-    for (std::size_t q = p + 1; q < n && sorted_lo_[q] <= hi; ++q) {
-      near_[found] = static_cast<std::uint32_t>(q);
-      found += static_cast<std::size_t>((sorted_y_[q].lo <= y_hi) & (sorted_y_[q].hi >= y_lo));
+    if (use_strips) {
+      // The same neighbours from the strips within one of i's: each strip's bodies after
+      // i (its cursor), up to the first whose box starts after i's ends, then in x order.
+      const std::uint32_t own = strip_of_[p];
+      ++strip_cursor_[own];   // i itself was the next of its strip
+      const std::uint32_t first = own > 0 ? own - 1 : 0, last = std::min<std::uint32_t>(own + 1, strips - 1);
+      for (std::uint32_t s = first; s <= last; ++s) {
+        const std::uint32_t end = strip_start_[s + 1];
+        for (std::uint32_t c = strip_cursor_[s]; c < end && strip_lo_[c] <= hi; ++c) {
+          near_[found] = strip_item_[c];
+          found += static_cast<std::size_t>((strip_y_[c].lo <= y_hi) & (strip_y_[c].hi >= y_lo));
+        }
+      }
+      for (std::size_t f = 1; f < found; ++f) {   // three short runs in x order, merged
+        const std::uint32_t v = near_[f];
+        std::size_t g = f;
+        for (; g > 0 && near_[g - 1] > v; --g) near_[g] = near_[g - 1];
+        near_[g] = v;
+      }
+    } else {
+      for (std::size_t q = p + 1; q < n && sorted_lo_[q] <= hi; ++q) {
+        near_[found] = static_cast<std::uint32_t>(q);
+        found += static_cast<std::size_t>((sorted_y_[q].lo <= y_hi) & (sorted_y_[q].hi >= y_lo));
+      }
     }
     for (std::size_t f = 0; f < found; ++f) {
       const std::size_t q = near_[f];
@@ -309,14 +386,21 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
       // when both steps were straight (neither body met anything in it), each bend added.
       // A point (radius 0) has passed into a circle when it gets half-way to its centre.
       const double smaller = std::min(ri, rj) > 0.0 ? std::min(ri, rj) : 0.5 * std::max(ri, rj);
+      // The bends (six square roots) are worked out only when they can decide: the path's
+      // closest approach plus a bend (>= 0) is never below the approach alone, so when the
+      // centres are inside now, or the path never comes inside, the answer is the same.
       double closest = ri + rj - depth;
-      if (const double off = bend(i) + bend(j); off < 0.5 * smaller) {
+      const double inside = smaller - eps_;
+      if (!(closest < inside)) {
         const Vec2 d0 = before(i) - before(j), dd = (xi - xj) - d0;
         const double len2 = dot(dd, dd);
         const double u = len2 > 0.0 ? std::clamp(-dot(d0, dd) / len2, 0.0, 1.0) : 1.0;
-        closest = std::min(closest, length(d0 + dd * u) + off);
+        const double along = length(d0 + dd * u);
+        if (along < inside) {
+          if (const double off = bend(i) + bend(j); off < 0.5 * smaller) closest = std::min(closest, along + off);
+        }
       }
-      if (closest < smaller - eps_ && smaller > 0.0) {
+      if (closest < inside && smaller > 0.0) {
         for (const std::size_t k : {i, j}) {
           if (escaped_[k]) continue;
           escaped_[k] = 1;

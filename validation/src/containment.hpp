@@ -38,6 +38,10 @@ class ContainmentMonitor {
 
   const ContainmentRecord& record() const { return record_; }
 
+  // Tests only: the moving pairs by the plain x sweep, never through horizontal strips
+  // (both must find the same pairs in the same order: test Containment.StripsEqualPlainSweep*).
+  void use_plain_sweep(bool plain) { plain_sweep_ = plain; }
+
  private:
   struct Barrier {
     bool circle = false;
@@ -72,7 +76,14 @@ class ContainmentMonitor {
     double lo, hi;
   };
   std::vector<YRange> sorted_y_;
+  std::vector<YRange> strip_y_;
   std::vector<std::uint32_t> near_;           // observe's scratch: one body's candidates
+  // Horizontal strips over the swept y intervals' lower ends (observe): per strip, its
+  // bodies' positions in x order, their left ends and y intervals, and a cursor past those
+  // already swept; strip_of_ per x-order position.
+  bool plain_sweep_ = false;
+  std::vector<std::uint32_t> strip_of_, strip_start_, strip_cursor_, strip_item_;
+  std::vector<double> strip_lo_;
   double max_radius_ = 0.0;                    // of the moving bodies
   std::vector<std::uint32_t> on_line_count_;   // on_line_ entries of the body
   // Each barrier's bounding box, widened by 2 eps: a body's path whose box misses it

@@ -316,6 +316,8 @@ void write_results(const std::filesystem::path& dir, const SuiteResult& result) 
   // Series first: results.json, written last, is what marks a complete output. The
   // report's scene player draws every body, so the series hold up to this many.
   constexpr std::size_t kMaxBodiesInSeries = 400;
+  std::unique_ptr<char[]> buffer;
+  std::size_t buffer_capacity = 0;
   for (const ScenarioResult& sr : result.scenarios) {
     const double cpu0 = thread_cpu_seconds();
     {
@@ -335,7 +337,10 @@ void write_results(const std::filesystem::path& dir, const SuiteResult& result) 
       for (std::size_t i = 0; i < nb; ++i) header += ",x_" + r.bodies[i].name + ",y_" + r.bodies[i].name;
       header += '\n';
       const std::size_t capacity = header.size() + r.series.time.size() * (7 + 2 * nb) * (kMaxNumber + 1);
-      const std::unique_ptr<char[]> buffer(new char[capacity]);   // not zeroed: written before read
+      if (capacity > buffer_capacity) {   // one buffer for all series: its pages are faulted in once
+        buffer.reset(new char[capacity]);   // not zeroed: written before read
+        buffer_capacity = capacity;
+      }
       std::memcpy(buffer.get(), header.data(), header.size());
       char* o = buffer.get() + header.size();
       auto put = [&](double v) {

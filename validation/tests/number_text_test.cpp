@@ -55,6 +55,29 @@ TEST(NumberText, EqualsToCharsOnRandomValues) {
   }
 }
 
+// Every layout the fast path writes (scientific, integer part with or without a fraction,
+// 0.[000]ddd), for every count of significant digits from 1 to 12, both signs, and the
+// neighbouring doubles (which carry 12 digits and may round up to the next decade).
+TEST(NumberText, EqualsToCharsForEveryLayoutAndDigitCount) {
+  const double inf = std::numeric_limits<double>::infinity();
+  for (int exp10 = -6; exp10 <= 11; ++exp10) {
+    for (int digits = 1; digits <= 12; ++digits) {
+      std::string text = "9";   // d.ddd...e<exp10> with `digits` digits, last one not 0
+      if (digits > 1) text += ".";
+      for (int d = 1; d < digits; ++d) {   // zeros inside, the last digit never 0
+        const int k = d * 7 + exp10 + 10;
+        text += static_cast<char>(d + 1 < digits ? '0' + k % 10 : '1' + k % 9);
+      }
+      for (const char* lead : {"1", "9"}) {
+        const double v = std::stod(lead + text.substr(1) + "e" + std::to_string(exp10));
+        for (const double w : {v, -v, std::nextafter(v, 0.0), std::nextafter(v, inf), -std::nextafter(v, inf)}) {
+          ASSERT_EQ(fast_text(w), reference_text(w)) << std::hexfloat << w;
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 
 // results.json's contacts are written as text, not through a json tree: the text must be
