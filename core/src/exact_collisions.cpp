@@ -558,11 +558,20 @@ class EventLoop {
       case EventKind::Stop: {
         // On the integrator's own path, which ends a sub-step (substeps.cpp).
         const double t = refine_stop(w_, e.a, e.time, w_.tloc[e.a], T_);
+        // A block of a train stops as one (its members' stops are the same instant; one
+        // by one, a member still moving would be met by the stopped one as an impact).
+        thread_local std::vector<std::uint32_t> mates;
+        stopping_mates(w_, e.a, mates);
         end_substep(w_, e.a, t);
-        w_.vel[e.a] = {};
-        support_path(w_, e.a);
+        stop_on_support(w_, e.a);
         ++w_.version[e.a];
         reschedule(e.a, t);
+        for (std::uint32_t m : mates) {
+          end_substep(w_, m, t);
+          stop_on_support(w_, m);
+          ++w_.version[m];
+          reschedule(m, t);
+        }
         break;
       }
       case EventKind::Leave: {

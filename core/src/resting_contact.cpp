@@ -55,6 +55,27 @@ void support_path(World& w, std::uint32_t i) {
   w.apath[i] = support_acceleration(w, i, w.acc[i], vt);
 }
 
+void stopping_mates(const World& w, std::uint32_t i, std::vector<std::uint32_t>& out) {
+  out.clear();
+  if (std::find(w.train_stopping.begin(), w.train_stopping.end(), i) == w.train_stopping.end()) return;
+  for (std::uint32_t m : w.train_stopping) {
+    if (m != i && w.train_block[m] == w.train_block[i]) out.push_back(m);
+  }
+}
+
+void stop_on_support(World& w, std::uint32_t i) {
+  w.vel[i] = {};
+  const auto it = std::find(w.train_stopping.begin(), w.train_stopping.end(), i);
+  if (it == w.train_stopping.end()) {
+    support_path(w, i);
+    return;
+  }
+  w.train_stopping.erase(it);
+  w.acc[i] = w.train_stop_acc[i];
+  support_path(w, i);
+  w.apath[i] = w.train_stop_apath[i];
+}
+
 Vec2 support_acceleration(const World& w, std::uint32_t i, Vec2 a, double vt) {
   const Segment& s = w.statics.segments[w.support[i]];
   const Vec2 n = w.support_n[i];
@@ -1345,6 +1366,75 @@ class NearGrid {
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed_;
 };
 
+// Two bodies on faces touching with no relative normal velocity (push_trains).
+struct TrainPair {
+  std::uint32_t i, j;
+  Vec2 nrm;   // from i to j
+  double P;   // the push between them
+};
+
+// Every pair of dynamic bodies on faces (not on bodies) touching one another with no
+// relative normal velocity, pressed by their own paths or not.
+void train_pairs(const World& w, std::vector<TrainPair>& pairs) {
+  const std::size_t n = w.size();
+  thread_local std::vector<std::uint32_t> cand;
+  cand.clear();
+  pairs.clear();
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (w.dynamic(i) && w.supported(i) && !w.on_body(i)) cand.push_back(i);
+  }
+  if (cand.size() < 2) return;
+  std::sort(cand.begin(), cand.end(), [&](std::uint32_t a, std::uint32_t b) {
+    const double la = w.pos[a].x - w.radius[a], lb = w.pos[b].x - w.radius[b];
+    return la < lb || (la == lb && a < b);
+  });
+  for (std::size_t x = 0; x < cand.size(); ++x) {
+    const std::uint32_t i = cand[x];
+    const double right = w.pos[i].x + w.radius[i];
+    for (std::size_t y = x + 1; y < cand.size(); ++y) {
+      const std::uint32_t j = cand[y];
+      const double tol_reach = 1e-9 * (w.radius[i] + w.radius[j] + w.length_scale);
+      if (w.pos[j].x - w.radius[j] > right + tol_reach) break;
+      if ((w.flags[i] & kPoint) && (w.flags[j] & kPoint)) continue;
+      if (((w.flags[i] | w.flags[j]) & kParticle) && related_bodies(w, i, j)) continue;
+      if (w.any_rules && !w.response(w.group[i], w.group[j]).collide) continue;
+      const Vec2 d = w.pos[j] - w.pos[i];
+      const double dl = length(d);
+      const double R = w.radius[i] + w.radius[j];
+      if (!(dl > 0.0) || std::fabs(dl - R) > 1e-9 * (R + w.length_scale)) continue;
+      const Vec2 nrm = d / dl;
+      const double vn = dot(w.vel[j] - w.vel[i], nrm);
+      if (std::fabs(vn) > 1e-12 * (length(w.vel[i]) + length(w.vel[j]))) continue;
+      pairs.push_back({i, j, nrm, 0.0});
+    }
+  }
+}
+
+// Whether a train pair lies on one line: one face normal, the pair's normal along the face.
+bool straight_pair(const World& w, const TrainPair& p) {
+  return w.support_n[p.i] == w.support_n[p.j] && std::fabs(dot(p.nrm, perp(w.support_n[p.i]))) >= 1.0 - 1e-12;
+}
+
+// Whether body i, on its face, touches nothing but its face and bodies that are in a
+// straight train with it (`train`: members of a straight pair): push_trains judges it
+// with them, as one rigid block, held or sliding.
+bool only_in_train(World& w, std::uint32_t i, std::span<const std::uint32_t> near, const std::vector<char>& train) {
+  if (!train[i]) return false;
+  thread_local std::vector<HeldContact> contacts;
+  thread_local std::vector<double> mu;
+  contacts.clear();
+  mu.clear();
+  touching_supports(w, i, near, contacts, mu);
+  for (const HeldContact& c : contacts) {
+    if (c.other & kBodySupport) {
+      if ((c.other & ~kBodySupport) != w.support[i]) return false;   // a second face
+    } else if (!(w.dynamic(c.other) && w.supported(c.other) && !w.on_body(c.other) && train[c.other])) {
+      return false;   // a held body, a body on a body, a static one
+    }
+  }
+  return true;
+}
+
 std::uint32_t held_partner_key(const World& w, const HeldContact& c) {
   return (c.other & kBodySupport) ? static_partner_key(w.statics.segments[c.other & ~kBodySupport].owner) : c.other;
 }
@@ -1385,6 +1475,26 @@ bool hold_pass(World& w, const StepContext& ctx) {
     for (std::uint32_t d : w.released) release_support(w, d);
   }
   if (changed) grid.build(w, std::max(2.0 * rmax, 1e-6 * w.length_scale) * (1.0 + 1e-6));
+  // Bodies in a straight train on a face: judged together by push_trains, not one by one
+  // (found at the first driven body).
+  thread_local std::vector<char> train;
+  thread_local std::vector<TrainPair> train_pair_list;
+  train.clear();
+  bool trains_found = w.varying_forces;
+  const auto in_a_train = [&](std::uint32_t i) {
+    if (!trains_found) {
+      trains_found = true;
+      train_pairs(w, train_pair_list);
+      for (const TrainPair& p : train_pair_list) {
+        if (!straight_pair(w, p)) continue;
+        if (train.empty()) train.assign(n, 0);
+        train[p.i] = train[p.j] = 1;
+      }
+    }
+    if (train.empty()) return false;
+    grid.query(w.pos[i], near);
+    return only_in_train(w, i, near, train);
+  };
   for (std::uint32_t i = 0; i < n; ++i) {
     if (!w.dynamic(i)) continue;
     // Free, or at rest on its face and driven along it (the face alone cannot hold it: a
@@ -1392,6 +1502,7 @@ bool hold_pass(World& w, const StepContext& ctx) {
     const bool driven = w.supported(i) && !w.on_body(i) && w.vel[i] == Vec2{} &&
                         (w.apath[i].x != 0.0 || w.apath[i].y != 0.0);
     if (w.supported(i) && !driven) continue;
+    if (driven && in_a_train(i)) continue;   // push_trains judges it
     grid.query(w.pos[i], near);
     group.clear();
     if (try_hold(w, i, ctx.dt, near)) {
@@ -1428,69 +1539,185 @@ bool hold_pass(World& w, const StepContext& ctx) {
   return changed;
 }
 
-// Bodies on faces pressed together while they slide (a ball pushing another down a
-// slope, the lower one's friction too much for the upper alone and too little for both):
-// rigid bodies in contact move together, so each member feels its neighbours' push as a
-// force. The pair forces P_k >= 0 (along each pair's normal; no friction between them)
-// are solved by Gauss-Seidel so that no pressed pair's relative acceleration along its
-// normal stays negative, each member's acceleration being its face's law
-// (support_acceleration: kinetic friction sliding, static from rest) under its own force
-// plus the pushes; the pushes are then added to the members' force accelerations for
-// the step and their paths recomputed, so every later event of the step (a stop, a hold)
-// sees them. Pairs are those touching, with no relative normal velocity, pressed by their
-// own paths. Constant forces only (under drag a face's law is integrated in sub-steps).
+// Bodies on faces touching one another while they slide or rest (a ball pushing another
+// down a slope, the lower one's friction too much for the upper alone and too little for
+// both): rigid bodies in contact move together, so each member feels its neighbours' push
+// as a force. The pairs are all those touching on faces with no relative normal velocity,
+// whether or not their own paths press them (two balls sliding alike behind a slower one
+// are pressed only once the front one's push slows the middle one). The pair forces
+// P_k >= 0 (along each pair's normal; no friction between them) solve the linear
+// complementarity problem P_k >= 0, relative normal acceleration w_k >= 0, P_k w_k = 0,
+// each member's acceleration being its face's law (support_acceleration: kinetic friction
+// sliding, static from rest) under its own force plus the pushes: projected Gauss-Seidel
+// finds it, a pair that separates keeps P = 0. A train of bodies on one line (one face
+// normal, every pressed pair's normal along the face) is then a rigid block: its
+// acceleration is its face's law for the block's total force, mass and friction, summed
+// in the order along the face (so the same bits whatever the numbering), and every member
+// gets that acceleration and the block's velocity to the bit (else round-off reads as an
+// approach and the touching pair is met as an impact at once). The pushes are added to
+// the members' force accelerations for the step and their paths recomputed, so every
+// later event of the step (a stop, a hold) sees them. Constant forces only (under drag a
+// face's law is integrated in sub-steps).
 void push_trains(World& w) {
   const std::size_t n = w.size();
-  thread_local std::vector<std::uint32_t> cand, parent;
+  thread_local std::vector<std::uint32_t> root, members, order;
   thread_local std::vector<Vec2> push;
-  struct Pair {
-    std::uint32_t i, j;
-    Vec2 nrm;   // from i to j
-    double P;
+  thread_local std::vector<char> mixed, in_block;
+  thread_local std::vector<TrainPair> pairs;
+  w.train_stopping.clear();
+  train_pairs(w, pairs);
+  if (pairs.empty()) return;
+  root.resize(n);
+  mixed.assign(n, 0);
+  in_block.assign(n, 0);
+  push.assign(n, Vec2{});
+  for (const TrainPair& p : pairs) root[p.i] = p.i, root[p.j] = p.j;
+  const auto find = [&](std::uint32_t m) {
+    while (root[m] != m) m = root[m] = root[root[m]];
+    return m;
   };
-  thread_local std::vector<Pair> pairs;
-  cand.clear();
-  pairs.clear();
-  for (std::uint32_t i = 0; i < n; ++i) {
-    if (w.dynamic(i) && w.supported(i) && !w.on_body(i)) cand.push_back(i);
+  // The face's law for a rigid block: members (sorted along the face, so the sums are the
+  // same bits whatever the numbering) all move at the block's velocity v (the first
+  // member's: they agree to round-off) and acceleration a.
+  struct Law {
+    double M = 0.0, F = 0.0, H = 0.0, K = 0.0;
+  };
+  const auto law_of = [&](std::uint32_t m) {
+    const Vec2 nn = w.support_n[m], tt = perp(nn);
+    const Coefficients c = coefficients(w, m, w.statics.segments[w.support[m]]);
+    const double mass = 1.0 / w.inv_mass[m];
+    const double N = mass * std::max(-dot(w.acc[m], nn), 0.0);
+    return Law{mass, mass * dot(w.acc[m], tt), c.holding * N, c.moving * N};
+  };
+  const auto block_a = [](const Law& L, double v) {
+    if (v == 0.0) return std::fabs(L.F) <= L.H ? 0.0 : (L.F - std::copysign(L.K, L.F)) / L.M;
+    return (L.F - std::copysign(L.K, v)) / L.M;
+  };
+  // The push (per mass) giving member m the block's a: sliding, the difference to its own
+  // law; at rest and held (a == 0), each member's friction taking its share of the block's
+  // force in proportion to what it can hold.
+  const auto push_for = [&](std::uint32_t m, const Law& L, double v, double a) {
+    const Vec2 tt = perp(w.support_n[m]);
+    const Law own = law_of(m);
+    if (v != 0.0 || a != 0.0) {
+      const double own_a = (own.F - std::copysign(own.K, v != 0.0 ? v : L.F)) / own.M;
+      return (a - own_a) * tt;
+    }
+    const double share = L.H > 0.0 ? L.F * (own.H / L.H) : 0.0;
+    return ((share - own.F) / own.M) * tt;
+  };
+  // Pooling a chain (sorted along the face, all at velocity v) from the rear: a block behind
+  // that would accelerate faster along the face than the block in front presses it and
+  // joins it (a tie to round-off joins too, so the pair keeps the same bits).
+  struct Pool {
+    std::size_t b, e;
+    Law L;
+    double a;
+  };
+  const auto pool = [&](std::span<const std::uint32_t> chain, double v, std::vector<Pool>& pools) {
+    pools.clear();
+    for (std::size_t x = 0; x < chain.size(); ++x) {
+      const Law L = law_of(chain[x]);
+      pools.push_back({x, x + 1, L, block_a(L, v)});
+      while (pools.size() > 1) {
+        const Pool& back = pools[pools.size() - 2];
+        const Pool& front = pools.back();
+        if (!(back.a - front.a > -1e-12 * (std::fabs(back.a) + std::fabs(front.a)))) break;
+        Pool joined{back.b, front.e, {back.L.M + front.L.M, back.L.F + front.L.F, back.L.H + front.L.H, back.L.K + front.L.K}, 0.0};
+        joined.a = block_a(joined.L, v);
+        pools.pop_back();
+        pools.back() = joined;
+      }
+    }
+  };
+  thread_local std::vector<Pool> rest_pools;
+  // Members of a block get its velocity and acceleration to the bit. static_push: at rest and
+  // held, keep the pushes the pair solver found (below). A block sliding to a stop also gets
+  // its path from rest (pooled again at v = 0) for its members' stop events.
+  const auto set_block = [&](std::span<const std::uint32_t> blk, const Law& L, double v, double a, bool static_push) {
+    const Vec2 tt = perp(w.support_n[blk[0]]);
+    if (blk.size() > 1 && v != 0.0 && a != 0.0 && (a > 0.0) != (v > 0.0)) {
+      if (w.train_stop_acc.size() < n) w.train_stop_acc.resize(n), w.train_stop_apath.resize(n), w.train_block.resize(n);
+      pool(blk, 0.0, rest_pools);
+      for (const Pool& q : rest_pools) {
+        for (std::size_t x = q.b; x < q.e; ++x) {
+          const std::uint32_t m = blk[x];
+          w.train_stop_acc[m] = w.acc[m] + push_for(m, q.L, 0.0, q.a);
+          w.train_stop_apath[m] = q.a * tt;
+          w.train_block[m] = blk[0];
+          w.train_stopping.push_back(m);
+        }
+      }
+    }
+    for (std::uint32_t m : blk) {
+      if (!(v == 0.0 && a == 0.0 && static_push)) push[m] = push_for(m, L, v, a);
+      if (blk.size() > 1) in_block[m] = 1;
+      w.acc[m] += push[m];
+      push[m] = {};
+      w.vel[m] = v * tt;
+      support_path(w, m);
+      w.vel[m] = v * tt;
+      w.apath[m] = a * tt;
+    }
+  };
+  const auto along = [&](std::uint32_t a, std::uint32_t b) {
+    const std::uint32_t ra = find(a), rb = find(b);
+    if (ra != rb) return ra < rb;
+    const Vec2 t = perp(w.support_n[a]);
+    return dot(w.pos[a], t) < dot(w.pos[b], t);
+  };
+  const auto gather = [&](auto&& keep) {   // members of kept pairs, by component, along the face
+    members.clear();
+    for (const TrainPair& p : pairs) {
+      if (keep(p)) members.push_back(p.i), members.push_back(p.j);
+    }
+    std::sort(members.begin(), members.end());
+    members.erase(std::unique(members.begin(), members.end()), members.end());
+    std::stable_sort(members.begin(), members.end(), along);
+  };
+
+  // Straight chains (bodies on one line, touching only one another there): exact, by
+  // pooling from the rear: a block behind that would accelerate faster along the face
+  // than the block in front presses it and joins it (the rigid Coulomb solution of the
+  // complementarity problem; a tie to round-off joins too, so the pair keeps the same bits).
+  for (const TrainPair& p : pairs) {
+    if (straight_pair(w, p)) root[find(p.i)] = find(p.j);
   }
-  if (cand.size() < 2) return;
-  std::sort(cand.begin(), cand.end(), [&](std::uint32_t a, std::uint32_t b) {
-    const double la = w.pos[a].x - w.radius[a], lb = w.pos[b].x - w.radius[b];
-    return la < lb || (la == lb && a < b);
-  });
-  for (std::size_t x = 0; x < cand.size(); ++x) {
-    const std::uint32_t i = cand[x];
-    const double right = w.pos[i].x + w.radius[i];
-    for (std::size_t y = x + 1; y < cand.size(); ++y) {
-      const std::uint32_t j = cand[y];
-      const double tol_reach = 1e-9 * (w.radius[i] + w.radius[j] + w.length_scale);
-      if (w.pos[j].x - w.radius[j] > right + tol_reach) break;
-      if ((w.flags[i] & kPoint) && (w.flags[j] & kPoint)) continue;
-      if (((w.flags[i] | w.flags[j]) & kParticle) && related_bodies(w, i, j)) continue;
-      if (w.any_rules && !w.response(w.group[i], w.group[j]).collide) continue;
-      const Vec2 d = w.pos[j] - w.pos[i];
-      const double dl = length(d);
-      const double R = w.radius[i] + w.radius[j];
-      if (!(dl > 0.0) || std::fabs(dl - R) > 1e-9 * (R + w.length_scale)) continue;
-      const Vec2 nrm = d / dl;
-      const double vn = dot(w.vel[j] - w.vel[i], nrm);
-      if (std::fabs(vn) > 1e-12 * (length(w.vel[i]) + length(w.vel[j]))) continue;
-      if (!(dot(w.apath[j] - w.apath[i], nrm) < 0.0)) continue;   // not pressed
-      pairs.push_back({i, j, nrm, 0.0});
+  for (const TrainPair& p : pairs) {
+    if (!straight_pair(w, p) || !(w.inv_mass[p.i] > 0.0) || !(w.inv_mass[p.j] > 0.0)) {
+      mixed[find(p.i)] = mixed[find(p.j)] = 1;
     }
   }
-  if (pairs.empty()) return;
-  push.assign(n, Vec2{});
+  gather([&](const TrainPair& p) { return !mixed[find(p.i)]; });
+  thread_local std::vector<Pool> pools;
+  for (std::size_t b = 0; b < members.size();) {
+    std::size_t e = b;
+    while (e < members.size() && find(members[e]) == find(members[b])) ++e;
+    const Vec2 tt = perp(w.support_n[members[b]]);
+    const double v = dot(w.vel[members[b]], tt);
+    const std::span<const std::uint32_t> chain = std::span<const std::uint32_t>(members).subspan(b, e - b);
+    pool(chain, v, pools);
+    for (const Pool& q : pools) set_block(chain.subspan(q.b, q.e - q.b), q.L, v, q.a, false);
+    b = e;
+  }
+
+  // Everything else (bodies of other sizes, on other faces): the pair forces P_k >= 0 by
+  // projected Gauss-Seidel, pairs that separate keeping P = 0; a pressed straight run in
+  // it is then a rigid block as above.
+  bool pressed = false;
+  const auto gs_pair = [&](const TrainPair& p) { return mixed[find(p.i)] != 0; };
   const auto acc_of = [&](std::uint32_t m) {
     const Vec2 t = perp(w.support_n[m]);
     return support_acceleration(w, m, w.acc[m] + push[m], dot(w.vel[m], t));
   };
   double amax = 0.0;
-  for (const Pair& p : pairs) amax = std::max({amax, length(w.acc[p.i]), length(w.acc[p.j])});
-  for (int iter = 0; iter < 100000; ++iter) {
+  for (const TrainPair& p : pairs) {
+    if (gs_pair(p)) amax = std::max({amax, length(w.acc[p.i]), length(w.acc[p.j])});
+  }
+  for (int iter = 0; amax > 0.0 && iter < 100000; ++iter) {
     double change = 0.0;
-    for (Pair& p : pairs) {
+    for (TrainPair& p : pairs) {
+      if (!gs_pair(p)) continue;
       const double wk = dot(acc_of(p.j) - acc_of(p.i), p.nrm);
       const double ti = dot(perp(w.support_n[p.i]), p.nrm), tj = dot(perp(w.support_n[p.j]), p.nrm);
       const double K = ti * ti * w.inv_mass[p.i] + tj * tj * w.inv_mass[p.j];
@@ -1499,29 +1726,63 @@ void push_trains(World& w) {
       const double dP = P - p.P;
       if (dP == 0.0) continue;
       p.P = P;
+      pressed = true;
       push[p.i] -= (dP * w.inv_mass[p.i]) * p.nrm;
       push[p.j] += (dP * w.inv_mass[p.j]) * p.nrm;
       change = std::max(change, std::fabs(dP) * K);
     }
     if (change <= 1e-15 * amax) break;
   }
-  for (const Pair& p : pairs) {
-    for (std::uint32_t m : {p.i, p.j}) {
-      if (push[m].x == 0.0 && push[m].y == 0.0) continue;
-      w.acc[m] += push[m];
-      push[m] = {};
-      support_path(w, m);
+  if (pressed) {
+    // Pressed straight runs: union-find again, over the pressed straight pairs only.
+    for (const TrainPair& p : pairs) {
+      if (gs_pair(p)) root[p.i] = p.i, root[p.j] = p.j;
+    }
+    for (const TrainPair& p : pairs) {
+      if (gs_pair(p) && p.P > 0.0 && straight_pair(w, p)) root[find(p.i)] = find(p.j);
+    }
+    gather([&](const TrainPair& p) { return gs_pair(p) && p.P > 0.0 && straight_pair(w, p); });
+    for (const TrainPair& p : pairs) {   // a member pressed off the line too is not a block's
+      if (gs_pair(p) && p.P > 0.0 && !straight_pair(w, p)) mixed[p.i] = mixed[p.j] = 2;
+    }
+    for (std::size_t b = 0; b < members.size();) {
+      std::size_t e = b;
+      bool off_line = false;
+      while (e < members.size() && find(members[e]) == find(members[b])) off_line |= mixed[members[e++]] == 2;
+      if (!off_line) {
+        const Vec2 tt = perp(w.support_n[members[b]]);
+        const double v = dot(w.vel[members[b]], tt);
+        Law L;
+        for (std::size_t x = b; x < e; ++x) {
+          const Law o = law_of(members[x]);
+          L = {L.M + o.M, L.F + o.F, L.H + o.H, L.K + o.K};
+        }
+        set_block(std::span<const std::uint32_t>(members).subspan(b, e - b), L, v, block_a(L, v), true);
+      }
+      b = e;
+    }
+    for (const TrainPair& p : pairs) {
+      if (!gs_pair(p)) continue;
+      for (std::uint32_t m : {p.i, p.j}) {
+        if (push[m].x == 0.0 && push[m].y == 0.0) continue;
+        w.acc[m] += push[m];
+        push[m] = {};
+        support_path(w, m);
+      }
     }
   }
-  // A pair on one line moves as one: the same velocity and acceleration to the bit (else
-  // round-off reads as an approach and the touching pair is met as an impact at once).
-  for (const Pair& p : pairs) {
-    if (w.support_n[p.i] != w.support_n[p.j]) continue;
+  // Pairs on one line that move alike (sliding alike, unpressed, or pushed off the line)
+  // move as one: the same velocity and acceleration to the bit (else round-off reads as an
+  // approach and the touching pair is met as an impact at once), a block's taken over by a
+  // body that is in none.
+  for (const TrainPair& p : pairs) {
+    if (w.support_n[p.i] != w.support_n[p.j] || (in_block[p.i] && in_block[p.j])) continue;
     const Vec2 dv = w.vel[p.j] - w.vel[p.i], da = w.apath[p.j] - w.apath[p.i];
     const double vs = length(w.vel[p.i]) + length(w.vel[p.j]), as = length(w.apath[p.i]) + length(w.apath[p.j]);
     if (length(dv) > 1e-12 * vs || length(da) > 1e-12 * as) continue;
-    w.vel[p.j] = w.vel[p.i];
-    w.apath[p.j] = w.apath[p.i];
+    const std::uint32_t from = in_block[p.j] ? p.j : p.i, to = from == p.i ? p.j : p.i;
+    w.vel[to] = w.vel[from];
+    w.apath[to] = w.apath[from];
   }
 }
 

@@ -165,6 +165,11 @@ struct World {
   std::vector<Vec2> acc;             // any_forces: force / mass at the step start
   std::vector<Vec2> apath;           // any_forces: the path's acceleration this step
   std::vector<Vec2> vcorr;           // varying_forces: end-of-step velocity correction
+  // push_trains: a member of a block sliding to a stop, its force acceleration and path
+  // once the block has stopped this step (the block judged again from rest).
+  std::vector<Vec2> train_stop_acc, train_stop_apath;
+  std::vector<std::uint32_t> train_stopping;   // the bodies that have them
+  std::vector<std::uint32_t> train_block;      // their block (its first member), to stop as one
   // varying_forces: each body's current sub-step. A step is one sub-step unless an
   // impact (or a lift-off) changes the body's velocity inside it; the integrator then
   // starts a new sub-step there (substeps.cpp). Its start time, state and acceleration:
@@ -359,6 +364,11 @@ void record_emission(World& w, std::uint32_t emitter, Vec2 position, Vec2 veloci
 // Path acceleration of a supported body: the normal component removed and Coulomb
 // friction (or rolling resistance) along the support (resting_contact.cpp).
 void support_path(World& w, std::uint32_t i);
+// Body i on a face comes to rest (its friction stop): its path from rest (a train's
+// member: the one push_trains found for its block from rest).
+void stop_on_support(World& w, std::uint32_t i);
+// The other members of body i's block sliding to a stop (they stop with it, at once).
+void stopping_mates(const World& w, std::uint32_t i, std::vector<std::uint32_t>& out);
 // The support's law for body i on its segment: the acceleration along the face under
 // the force acceleration a (its normal part taken by the support), with kinetic
 // friction against the sign of vt, or at vt == 0 held by static friction up to its limit.

@@ -31,14 +31,7 @@ std::string run_for_report(Sim& sim) {
 // Ball-floor friction mu on the named balls (the pair rule sqrt(f1 f2) would give 0 under
 // frictionless balls); the balls themselves are frictionless.
 void floor_friction(Scene& sc, const std::vector<std::string>& names, double mu) {
-  for (const std::string& nm : names) {
-    MaterialOverride m;
-    m.a = nm;
-    m.b = "floor";
-    m.friction = mu;
-    m.static_friction = mu;
-    sc.materials.push_back(m);
-  }
+  for (const std::string& nm : names) sc.materials.push_back(pair_friction(nm, "floor", mu));
 }
 
 }  // namespace

@@ -47,6 +47,16 @@ inline WallDef wall(std::string name, Vec2 from, Vec2 to, double e = 1.0, double
   return w;
 }
 
+// A [[materials]] override of a pair's friction (kinetic and static both mu).
+inline MaterialOverride pair_friction(std::string a, std::string b, double mu) {
+  MaterialOverride m;
+  m.a = std::move(a);
+  m.b = std::move(b);
+  m.friction = mu;
+  m.static_friction = mu;
+  return m;
+}
+
 inline Scene scene_of(std::vector<BodyDef> bodies, std::vector<WallDef> walls = {}, Vec2 gravity = {}) {
   Scene s;
   s.name = "test";

@@ -39,20 +39,9 @@ Scene train(double deg, double mub, double muf, double mb, double mf, double v0,
   if (front_first) std::swap(b[0], b[1]);
   Scene sc = scene_of(b, {wall("floor", -60.0 * t, 60.0 * t, 0.0, 1.0)}, {0.0, -g});
   // Each ball's own friction with the floor, none between the balls.
-  for (const auto& [who, mu] : {std::pair<std::string, double>{"back", mub}, {"front", muf}}) {
-    MaterialOverride m;
-    m.a = who;
-    m.b = "floor";
-    m.friction = mu;
-    m.static_friction = mu;
-    sc.materials.push_back(m);
-  }
-  MaterialOverride none;
-  none.a = "back";
-  none.b = "front";
-  none.friction = 0.0;
-  none.static_friction = 0.0;
-  sc.materials.push_back(none);
+  sc.materials.push_back(pair_friction("back", "floor", mub));
+  sc.materials.push_back(pair_friction("front", "floor", muf));
+  sc.materials.push_back(pair_friction("back", "front", 0.0));
   return sc;
 }
 
