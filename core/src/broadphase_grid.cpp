@@ -120,33 +120,48 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     hash_.choose(count, cells_x, cells_y);
 
     // Each body's bucket (kNil: inactive or oversize), counted.
-    start_.assign(hash_.buckets + 2, 0);
+    // (Through local pointers: the stores into one array would otherwise make the
+    // compiler reload the others' and the members' values in every iteration.)
+    const std::uint32_t buckets = hash_.buckets;
+    const bp_detail::TileHash hash = hash_;
+    const double cell_edge = cell_;
+    start_.assign(buckets + 2, 0);
     pos_of_.resize(n);
+    std::uint32_t* const start = start_.data();
+    std::uint32_t* const pos_of = pos_of_.data();
+    const Aabb* const boxes = boxes_.data();
+    const std::uint8_t* const act = active_.data();
     for (std::uint32_t i = 0; i < n; ++i) {
-      pos_of_[i] = kNil;
-      if (!active_[i]) continue;
-      if (bp_detail::extent(boxes_[i]) > cell_) {
+      pos_of[i] = kNil;
+      if (!act[i]) continue;
+      if (bp_detail::extent(boxes[i]) > cell_edge) {
         oversize_.push_back(i);
         continue;
       }
       std::int32_t cx, cy;
-      centre_cell(boxes_[i], cx, cy);
-      pos_of_[i] = hash_(cx, cy);
-      ++start_[pos_of_[i] + 2];
+      centre_cell(boxes[i], cx, cy);
+      const std::uint32_t b = hash(cx, cy);
+      pos_of[i] = b;
+      ++start[b + 2];
     }
     // Counting sort: start_[b + 1] becomes the fill cursor of bucket b, then its end.
     // Each body's slot is written whole where it lands (stamp 0: no query has it).
-    for (std::uint32_t b = 0; b < hash_.buckets; ++b) start_[b + 2] += start_[b + 1];
-    std::uint32_t tail = start_[hash_.buckets + 1];   // unbinned bodies after the buckets
+    std::uint32_t running = 0;
+    for (std::uint32_t b = 0; b < buckets; ++b) {
+      running += start[b + 2];
+      start[b + 2] = running;
+    }
+    std::uint32_t tail = start[buckets + 1];   // unbinned bodies after the buckets
+    Slot* const slots = slots_.data();
     for (std::uint32_t i = 0; i < n; ++i) {
-      const std::uint32_t k = pos_of_[i] == kNil ? tail++ : start_[pos_of_[i] + 1]++;
+      const std::uint32_t k = pos_of[i] == kNil ? tail++ : start[pos_of[i] + 1]++;
       Slot s;
-      s.box = boxes_[i];
+      s.box = boxes[i];
       centre_cell(s.box, s.hx, s.hy);
       s.body = i;
       s.stamp = 0;
-      slots_[k] = s;
-      pos_of_[i] = k;
+      slots[k] = s;
+      pos_of[i] = k;
     }
     for (std::uint32_t o : oversize_) {
       slots_[pos_of_[o]].hx = kOversizeHome;
@@ -164,50 +179,54 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
   }
 
   void pairs(std::vector<BodyPair>& out) override {
-    static constexpr std::int32_t kForward[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
-    // The forward neighbours of the last home cell seen: the bodies of a bucket mostly
-    // share one, so its buckets are looked up once per bucket, not once per body.
-    struct Neighbour {
-      std::int32_t x, y;
-      std::uint32_t begin, end;   // its bucket's positions (empty: off the int32 range)
-    };
-    Neighbour near[4];
-    std::int32_t last_x = 0, last_y = 0;
-    bool have_last = false;
-    for (std::uint32_t b = 0; b < hash_.buckets; ++b) {
-      const std::uint32_t end = start_[b + 1];
-      for (std::uint32_t k = start_[b]; k < end; ++k) {
-        const Slot& sk = slots_[k];
-        const Aabb& a = sk.box;
+    // Each body's forward neighbours: the later bodies of its own cell, the cell to its
+    // right, and the three cells of the row above. With the tiling unbroken there
+    // (the usual case), its own and the right cell's buckets are consecutive, and so
+    // are the three above: two runs of positions, each tested without a branch per
+    // box (the overlap test mostly fails, and unpredictably). Bodies of other cells
+    // that share those buckets are told apart by their home cells.
+    // (Local copies: the pairs' stores would otherwise make the compiler reload the
+    // members after each.)
+    const bp_detail::TileHash hash = hash_;
+    const std::uint32_t wmask = hash.wmask, hmask = hash.hmask;
+    const std::uint32_t* const start = start_.data();
+    const Slot* const slots = slots_.data();
+    std::size_t used = out.size();
+    for (std::uint32_t b = 0; b < hash.buckets; ++b) {
+      const std::uint32_t end = start[b + 1];
+      for (std::uint32_t k = start[b]; k < end; ++k) {
+        const Slot& sk = slots[k];
         const std::int32_t cx = sk.hx, cy = sk.hy;
-        for (std::uint32_t k2 = k + 1; k2 < end; ++k2) {
-          const Slot& s2 = slots_[k2];
-          if (overlaps(a, s2.box) && s2.hx == cx && s2.hy == cy) push(out, sk.body, s2.body);
+        const std::uint32_t tx = static_cast<std::uint32_t>(cx) & wmask;
+        if (tx == 0 || tx == wmask || (static_cast<std::uint32_t>(cy) & hmask) == hmask) {
+          pairs_generic(k, end, out, used);
+          continue;
         }
-        if (!have_last || cx != last_x || cy != last_y) {
-          have_last = true;
-          last_x = cx;
-          last_y = cy;
-          for (int d = 0; d < 4; ++d) {
-            const std::int64_t nx = static_cast<std::int64_t>(cx) + kForward[d][0];
-            const std::int64_t ny = static_cast<std::int64_t>(cy) + kForward[d][1];
-            if (nx > 2147483646 || nx < -2147483647 || ny > 2147483646) {
-              near[d] = {0, 0, 0, 0};
-              continue;
-            }
-            const auto ncx = static_cast<std::int32_t>(nx), ncy = static_cast<std::int32_t>(ny);
-            const std::uint32_t nb = hash_(ncx, ncy);
-            near[d] = {ncx, ncy, start_[nb], start_[nb + 1]};
-          }
+        const std::uint32_t up = hash(cx, cy + 1);   // the bucket above: (cx, cy + 1)
+        const std::uint32_t r0 = k + 1, r1 = start[b + 2];
+        const std::uint32_t u0 = start[up - 1], u1 = start[up + 2];
+        const std::size_t need = used + (r1 - r0) + (u1 - u0);
+        if (out.size() < need) out.resize(std::max<std::size_t>(need, 2 * out.size() + 64));
+        BodyPair* o = out.data();
+        const Aabb a = sk.box;
+        const std::uint32_t body = sk.body;
+        const auto ucx = static_cast<std::uint32_t>(cx);
+        for (std::uint32_t k2 = r0; k2 < r1; ++k2) {
+          const Slot& s2 = slots[k2];
+          const bool hit = overlaps_nb(a, s2.box) & (s2.hy == cy) & (static_cast<std::uint32_t>(s2.hx) - ucx <= 1u);
+          o[used] = ordered(body, s2.body);
+          used += hit;
         }
-        for (const Neighbour& nd : near) {
-          for (std::uint32_t k2 = nd.begin; k2 < nd.end; ++k2) {
-            const Slot& s2 = slots_[k2];
-            if (overlaps(a, s2.box) && s2.hx == nd.x && s2.hy == nd.y) push(out, sk.body, s2.body);
-          }
+        const std::int32_t uy = cy + 1;
+        for (std::uint32_t k2 = u0; k2 < u1; ++k2) {
+          const Slot& s2 = slots[k2];
+          const bool hit = overlaps_nb(a, s2.box) & (s2.hy == uy) & (static_cast<std::uint32_t>(s2.hx) - ucx + 1u <= 2u);
+          o[used] = ordered(body, s2.body);
+          used += hit;
         }
       }
     }
+    out.resize(used);
     for (std::uint32_t o : oversize_) {
       const Aabb& a = box(o);
       for (std::uint32_t j = 0; j < active_.size(); ++j) {
@@ -236,7 +255,38 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
       }
       return;
     }
+    // A row whose cells are consecutive buckets (the tiling does not wrap within it) and
+    // hold no extra entries is one run of positions: scanned without a branch per box,
+    // in the order the cell-by-cell scan below reports (bucket by bucket, each in
+    // position order). Any body whose home moved within the row has an extra entry
+    // there, so a run's bodies are at home: in the row and within [x0, x1].
+    const std::uint32_t span = static_cast<std::uint32_t>(x1) - static_cast<std::uint32_t>(x0);
+    const bool runs = span < hash_.wmask + 1u &&
+                      (static_cast<std::uint32_t>(x0) & hash_.wmask) <= (static_cast<std::uint32_t>(x1) & hash_.wmask);
     for (std::int32_t y = y0;; ++y) {
+      if (runs) {
+        const std::uint32_t b0 = hash_(x0, y), b1 = b0 + span;
+        std::uint32_t extras = kNil;
+        for (std::uint32_t b = b0; b <= b1; ++b) extras &= extra_head_[b];
+        if (extras == kNil) {
+          const std::uint32_t p0 = start_[b0], p1 = start_[b1 + 1];
+          std::size_t used = out.size();
+          out.resize(used + (p1 - p0));
+          std::uint32_t* o = out.data();
+          const auto ux0 = static_cast<std::uint32_t>(x0);
+          for (std::uint32_t k = p0; k < p1; ++k) {
+            Slot& sl = slots_[k];
+            const bool hit = (sl.hy == y) & (static_cast<std::uint32_t>(sl.hx) - ux0 <= span) & overlaps_nb(q, sl.box) &
+                             (sl.stamp != stamp);
+            o[used] = sl.body;
+            used += hit;
+            sl.stamp = hit ? stamp : sl.stamp;
+          }
+          out.resize(used);
+          if (y == y1) break;
+          continue;
+        }
+      }
       for (std::int32_t x = x0;; ++x) {
         const std::uint32_t b = hash_(x, y);
         for (std::uint32_t k = start_[b]; k < start_[b + 1]; ++k) visit(k, x, y, q, stamp, out);
@@ -320,6 +370,39 @@ class GridBroadPhase final : public bp_detail::BroadPhaseBase {
     extra_body_.push_back(entry);
     extra_next_.push_back(extra_head_[bucket]);
     extra_head_[bucket] = static_cast<std::uint32_t>(extra_body_.size() - 1);
+  }
+  // overlaps() without the short-circuit branches.
+  static bool overlaps_nb(const Aabb& a, const Aabb& b) {
+    return (a.min_x <= b.max_x) & (b.min_x <= a.max_x) & (a.min_y <= b.max_y) & (b.min_y <= a.max_y);
+  }
+  static BodyPair ordered(std::uint32_t i, std::uint32_t j) { return i < j ? BodyPair{i, j} : BodyPair{j, i}; }
+  // The forward pairs of the body at position k (its bucket ends at `end`), each
+  // neighbouring cell's bucket looked up through the hash: for cells where the tiling
+  // wraps (and a scene wider or taller than the tiles).
+  void pairs_generic(std::uint32_t k, std::uint32_t end, std::vector<BodyPair>& out, std::size_t& used) const {
+    const auto emit = [&](std::uint32_t i, std::uint32_t j) {
+      if (used == out.size()) out.resize(2 * out.size() + 64);
+      out[used++] = ordered(i, j);
+    };
+    static constexpr std::int32_t kForward[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
+    const Slot& sk = slots_[k];
+    const Aabb& a = sk.box;
+    const std::int32_t cx = sk.hx, cy = sk.hy;
+    for (std::uint32_t k2 = k + 1; k2 < end; ++k2) {
+      const Slot& s2 = slots_[k2];
+      if (overlaps(a, s2.box) && s2.hx == cx && s2.hy == cy) emit(sk.body, s2.body);
+    }
+    for (int d = 0; d < 4; ++d) {
+      const std::int64_t nx = static_cast<std::int64_t>(cx) + kForward[d][0];
+      const std::int64_t ny = static_cast<std::int64_t>(cy) + kForward[d][1];
+      if (nx > 2147483646 || nx < -2147483647 || ny > 2147483646) continue;
+      const auto ncx = static_cast<std::int32_t>(nx), ncy = static_cast<std::int32_t>(ny);
+      const std::uint32_t nb = hash_(ncx, ncy);
+      for (std::uint32_t k2 = start_[nb]; k2 < start_[nb + 1]; ++k2) {
+        const Slot& s2 = slots_[k2];
+        if (overlaps(a, s2.box) && s2.hx == ncx && s2.hy == ncy) emit(sk.body, s2.body);
+      }
+    }
   }
   static void push(std::vector<BodyPair>& out, std::uint32_t i, std::uint32_t j) {
     out.push_back(i < j ? BodyPair{i, j} : BodyPair{j, i});

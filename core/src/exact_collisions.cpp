@@ -63,7 +63,18 @@ class EventLoop {
         T_(ctx.dt),
         coupled_(w.coupled()),
         fast_isolated_(w.impact_law == ImpactLaw::Simultaneous && !w.any_rules && !w.any_forces && !w.varying_forces &&
-                       !w.coupled()) {}
+                       !w.coupled()) {
+    // A few faces: their boxes, as StaticGeometry builds them, to skip its query for
+    // a box that meets none (most bodies of a walled gas, away from the walls).
+    if (w.statics.segments.size() <= kFewFaces) {
+      for (const Segment& s : w.statics.segments) {
+        face_boxes_[face_count_++] = make_aabb(std::min(s.from.x, s.to.x), std::min(s.from.y, s.to.y),
+                                               std::max(s.from.x, s.to.x), std::max(s.from.y, s.to.y));
+      }
+    } else {
+      face_count_ = kManyFaces;
+    }
+  }
 
   void run() {
     prune_passing(w_);
@@ -115,7 +126,7 @@ class EventLoop {
     for (const BodyPair& p : w_.pairs) schedule_pair(p.a, p.b, t);
     for (std::uint32_t i = 0; i < n; ++i) {
       if (!w_.dynamic(i)) continue;
-      schedule_statics(i, t, w_.bp->box(i));
+      schedule_statics(i, t, boxes[i]);   // (its registered box: none has grown yet)
       schedule_body(i, t);
     }
   }
@@ -218,6 +229,16 @@ class EventLoop {
     const Vec2 d0 = pj - pi;
     if (dot(d0, dv) >= 0.0 && dot(d0, da) >= 0.0 && length_squared(d0) >= R * R) return;
     const double scale = inf_norm(pi) + inf_norm(pj) + R;
+    if (da.x == 0.0 && da.y == 0.0) {
+      // toi::circle_circle's own rejections (separating, or never close enough), before
+      // the speed its tolerance needs costs two square roots: its touch tolerance is
+      // toi::squared_tolerance's, computed the same way.
+      const double b = dot(d0, dv);
+      const double c = dot(d0, d0) - R * R;
+      const double touch = 2.0 * R * 64.0 * 2.220446049250313e-16 * scale + 64.0 * 2.220446049250313e-16 * R * R;
+      if (b >= 0.0 && c > touch) return;
+      if (c > touch && b * b < dot(dv, dv) * c) return;
+    }
     // Round-off in dv is that of the bodies' own velocities, not of their difference: two
     // touching bodies moving together (an inelastic pair) approach at ~1e-17 m/s, an
     // impulse that small changes no velocity, and the same impact would fire forever.
@@ -227,8 +248,19 @@ class EventLoop {
     push(Event::make(t + s, i, j, w_.version[i], w_.version[j], EventKind::Pair));
   }
 
-  void schedule_statics(std::uint32_t i, double t, const Aabb& box) {
-    if (w_.statics.segments.empty()) return;
+  // Whether a face's box may overlap `box` (false: StaticGeometry::query finds none).
+  [[gnu::always_inline]] bool may_meet_faces(const Aabb& box) const {
+    if (face_count_ == kManyFaces) return true;
+    bool any = false;
+    for (std::uint32_t k = 0; k < face_count_; ++k) any |= overlaps(box, face_boxes_[k]);
+    return any;
+  }
+
+  // (The test inline, the rest a call: most bodies of a walled gas meet no face.)
+  [[gnu::always_inline]] void schedule_statics(std::uint32_t i, double t, const Aabb& box) {
+    if (may_meet_faces(box)) schedule_faces(i, t, box);
+  }
+  [[gnu::noinline]] void schedule_faces(std::uint32_t i, double t, const Aabb& box) {
     w_.found_static.clear();
     w_.statics.query(box, w_.found_static);
     if (w_.found_static.empty()) return;
@@ -389,8 +421,10 @@ class EventLoop {
   bool near_face(Vec2 p, double r, std::uint32_t except) {
     if (w_.statics.segments.empty()) return false;
     const double pad = r * (1.0 + 1e-6) + 1e-9 * (inf_norm(p) + w_.length_scale);
+    const Aabb box = make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad);
+    if (!may_meet_faces(box)) return false;
     w_.found_static.clear();
-    w_.statics.query(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), w_.found_static);
+    w_.statics.query(box, w_.found_static);
     for (std::uint32_t k : w_.found_static) {
       if (k == except) continue;
       const Segment& s = w_.statics.segments[k];
@@ -870,6 +904,9 @@ class EventLoop {
   // near is the pairwise law's, proven without the touching set (isolated_pair).
   const bool fast_isolated_;
   Aabb found_box_i_, found_box_j_;   // the new paths' boxes isolated_pair/_static found
+  static constexpr std::uint32_t kFewFaces = 8, kManyFaces = 0xffffffffu;
+  Aabb face_boxes_[kFewFaces];       // the faces' boxes, when there are few (face_count_)
+  std::uint32_t face_count_ = 0;     // kManyFaces: ask StaticGeometry every time
   std::vector<std::uint32_t> set_;      // the touching set of a simultaneous impact
   std::vector<BodyPair> impacted_;      // its pairs that took an impulse
   std::vector<std::uint32_t> near_;     // bodies near one being held
