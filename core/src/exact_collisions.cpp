@@ -643,8 +643,6 @@ class EventLoop {
             settled = true;   // at rest on several supports
           } else if (hold_pocket(i) || hold_pocket(j)) {
             settled = true;   // a group micro-bouncing on its supports: its pocket
-          } else if (join_as_block(w_, i, j, n)) {
-            settled = true;   // two bodies on a face pressed together: one block (a train)
           } else {
             min_sep = 0.5 * vr;
           }

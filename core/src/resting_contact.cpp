@@ -1853,49 +1853,6 @@ void apply_supports(World& w, const StepContext& ctx) {
   if (!w.varying_forces) push_trains(w);
 }
 
-bool join_as_block(World& w, std::uint32_t i, std::uint32_t j, Vec2 n) {
-  if (w.varying_forces || w.any_rules) return false;
-  for (std::uint32_t x : {i, j}) {
-    if (!w.dynamic(x) || !w.supported(x) || w.on_body(x) || w.is_held(x)) return false;
-  }
-  const Vec2 nn = w.support_n[i];
-  if (!(w.support_n[j] == nn) || std::fabs(dot(n, nn)) > 1e-9) return false;
-  const Vec2 tt = perp(nn);
-  // The block's law, as push_trains' (members summed in the order along the face, so the
-  // same bits whatever the numbering).
-  const bool i_first = dot(w.pos[i], tt) <= dot(w.pos[j], tt);
-  double M = 0.0, P = 0.0, F = 0.0, H = 0.0, K = 0.0;
-  for (std::uint32_t x : {i_first ? i : j, i_first ? j : i}) {
-    const Coefficients c = coefficients(w, x, w.statics.segments[w.support[x]]);
-    const double mass = 1.0 / w.inv_mass[x];
-    const double N = mass * std::max(-dot(w.acc[x], nn), 0.0);
-    M += mass;
-    P += mass * dot(w.vel[x], tt);
-    F += mass * dot(w.acc[x], tt);
-    H += c.holding * N;
-    K += c.moving * N;
-  }
-  const double v = P / M;
-  double a;
-  if (v == 0.0) {
-    a = std::fabs(F) <= H ? 0.0 : (F - std::copysign(K, F)) / M;
-  } else {
-    a = (F - std::copysign(K, v)) / M;
-  }
-  // Only a pair the block's law keeps together: each member alone would press the other
-  // (its own law's acceleration towards it at least the block's).
-  for (std::uint32_t x : {i, j}) {
-    const Vec2 toward = x == i ? n : -n;   // n points from i to j
-    const double own = dot(support_acceleration(w, x, w.acc[x], v), toward);
-    if (own < dot(a * tt, toward) - 1e-12 * (std::fabs(a) + length(w.acc[x]))) return false;
-  }
-  for (std::uint32_t x : {i, j}) {
-    w.vel[x] = v * tt;
-    w.apath[x] = a * tt;
-  }
-  return true;
-}
-
 double support_stop_time(const World& w, std::uint32_t i, double t, double T) {
   if (w.on_body(i)) return toi::kNever;   // stuck
   const Vec2 tang = perp(w.support_n[i]);

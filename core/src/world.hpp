@@ -367,12 +367,6 @@ void support_path(World& w, std::uint32_t i);
 // Body i on a face comes to rest (its friction stop): its path from rest (a train's
 // member: the one push_trains found for its block from rest).
 void stop_on_support(World& w, std::uint32_t i);
-// Bodies i and j, both on faces with one normal and touching along it, met slowly and
-// pressed together inside a step: they move on as one block for the rest of the step
-// (their momentum shared, the face's law for their total force, mass and friction) instead
-// of micro-bouncing; push_trains takes the pair over at the next step's start. False (and
-// nothing changed) when they are not such a pair.
-bool join_as_block(World& w, std::uint32_t i, std::uint32_t j, Vec2 n);
 // The other members of body i's block sliding to a stop (they stop with it, at once).
 void stopping_mates(const World& w, std::uint32_t i, std::vector<std::uint32_t>& out);
 // The support's law for body i on its segment: the acceleration along the face under
