@@ -163,6 +163,20 @@ bool related_bodies(const World& w, std::uint32_t i, std::uint32_t j) {
   return false;
 }
 
+// Whether bodies a and b may collide and touch, within 1e-9 of contact (as
+// touching_supports); n: the unit normal from b towards a.
+bool in_contact(const World& w, std::uint32_t a, std::uint32_t b, Vec2& n) {
+  if ((w.flags[a] & kPoint) && (w.flags[b] & kPoint)) return false;
+  if (((w.flags[a] | w.flags[b]) & kParticle) && related_bodies(w, a, b)) return false;
+  if (w.any_rules && !w.response(w.group[a], w.group[b]).collide) return false;
+  const Vec2 d = w.pos[a] - w.pos[b];
+  const double dist = length(d);
+  const double R = w.radius[a] + w.radius[b];
+  if (!(dist > 0.0) || std::fabs(dist - R) > 1e-9 * (R + w.length_scale)) return false;
+  n = d / dist;
+  return true;
+}
+
 double holding_coefficient(const PairMaterial& m) {
   return m.rolling_friction > 0.0 ? m.rolling_friction : std::max(m.static_friction, m.friction);
 }
@@ -942,14 +956,9 @@ struct BodiesByX {
     for (; it != order.end() && w.pos[*it].x <= w.pos[m].x + reach; ++it) {
       const std::uint32_t j = *it;
       if (j == m || std::fabs(w.pos[j].y - w.pos[m].y) > reach) continue;
-      if ((w.flags[m] & kPoint) && (w.flags[j] & kPoint)) continue;
-      if (((w.flags[m] | w.flags[j]) & kParticle) && related_bodies(w, m, j)) continue;
-      if (w.any_rules && !w.response(w.group[m], w.group[j]).collide) continue;
-      const Vec2 d = w.pos[m] - w.pos[j];
-      const double dist = length(d);
-      const double R = w.radius[m] + w.radius[j];
-      if (!(dist > 0.0) || std::fabs(dist - R) > 1e-9 * (R + w.length_scale)) continue;
-      out.push_back({j, d / dist});
+      Vec2 nrm;
+      if (!in_contact(w, m, j, nrm)) continue;
+      out.push_back({j, nrm});
     }
   }
 };
@@ -1398,14 +1407,9 @@ void train_pairs(const World& w, std::vector<TrainPair>& pairs) {
       const std::uint32_t j = cand[y];
       const double tol_reach = 1e-9 * (w.radius[i] + w.radius[j] + w.length_scale);
       if (w.pos[j].x - w.radius[j] > right + tol_reach) break;
-      if ((w.flags[i] & kPoint) && (w.flags[j] & kPoint)) continue;
-      if (((w.flags[i] | w.flags[j]) & kParticle) && related_bodies(w, i, j)) continue;
-      if (w.any_rules && !w.response(w.group[i], w.group[j]).collide) continue;
-      const Vec2 d = w.pos[j] - w.pos[i];
-      const double dl = length(d);
-      const double R = w.radius[i] + w.radius[j];
-      if (!(dl > 0.0) || std::fabs(dl - R) > 1e-9 * (R + w.length_scale)) continue;
-      const Vec2 nrm = d / dl;
+      Vec2 from_j;
+      if (!in_contact(w, i, j, from_j)) continue;
+      const Vec2 nrm = -from_j;   // from i to j
       const double vn = dot(w.vel[j] - w.vel[i], nrm);
       if (std::fabs(vn) > 1e-12 * (length(w.vel[i]) + length(w.vel[j]))) continue;
       pairs.push_back({i, j, nrm, 0.0});
