@@ -15,6 +15,11 @@
 #   vtrough   a ball into a symmetric V (half-angle 50-85 deg, e 0/0.3/0.7, both wall orders)
 #   headon    head-on pairs, mass ratios 1e-6..1e6, e 0/0.5/1, sizes 1 mm..1 km, with their
 #             closed forms as [expect]: core must meet them; no engine may pass a 10% miss
+#   floorslide, settle, slope, edge   one body's closed form (friction stop, bounces to rest,
+#             held or sliding on a slope drawn three ways, sliding off a table's end): core
+#             must meet it to 1e-6 or better
+#   draglin, dragquad, thrust   the converged reference must meet the closed form
+#   every closed-form run: an engine's position_divergence must see its miss
 set -euo pipefail
 build=build
 jobs=$(nproc)
@@ -186,6 +191,208 @@ restitution = {e}
 final = [ {{ body = "a", velocity = [{v1!r}, 0.0], tolerance = {tol!r} }},
           {{ body = "b", velocity = [{v2!r}, 0.0], tolerance = {tol!r} }} ]
 ''')
+
+# Closed forms for the models one body at a time (truth.json: the exact final state, and
+# the tolerance core, the reference, must meet it to). Found by this grid: `edge`.
+truth = {}
+g = 9.8
+def exact(name, text, pos, vel, tol, judge="core"):
+    write(name, text)
+    truth[name] = {"position": pos, "velocity": vel, "tol": tol, "judge": judge}
+
+# floorslide: a ball sliding on a floor, kinetic or rolling friction mu: decelerated by
+# mu g until it stops at v0^2 / (2 mu g) (T before and after the stop).
+for kind in ["friction", "rolling_friction"]:
+    for v0 in [0.5, 3.0, 12.0]:
+        for mu in [0.05, 0.3, 1.0]:
+            for frac in [0.6, 1.5]:
+                for steps in [60, 240]:
+                    ts = v0 / (mu * g)
+                    t = min(frac * ts, ts)
+                    x, v = v0 * t - 0.5 * mu * g * t * t, (v0 - mu * g * t if frac < 1 else 0.0)
+                    n = f"floorslide_{kind[0]}_{v0}_{mu}_{frac}_{steps}".replace(".", "p")
+                    exact(n, f"""name = "{n}"
+duration = {frac * ts!r}
+dt = "1/{steps}"
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+radius = 0.5
+position = [0.0, 0.5]
+velocity = [{v0}, 0.0]
+restitution = 0.0
+{kind} = {mu}
+[[walls]]
+name = "floor"
+from = [-200.0, 0.0]
+to = [200.0, 0.0]
+restitution = 0.0
+{kind} = {mu}
+""", [x, 0.5], [v, 0.0], 1e-7 * max(1.0, x))
+
+# settle: a drop from h with restitution e, before and after it comes to rest
+# (t_inf = sqrt(2h/g) (1+e)/(1-e)): the bounces' closed form at T.
+def bounce_state(h, e, T):
+    t = math.sqrt(2 * h / g)
+    if T <= t:
+        return h - 0.5 * g * T * T, -g * T
+    v = e * g * t
+    while v > 1e-12:
+        if T <= t + 2 * v / g:
+            s = T - t
+            return v * s - 0.5 * g * s * s, v - g * s
+        t += 2 * v / g
+        v *= e
+    return 0.0, 0.0
+for h in [0.3, 2.0, 10.0]:
+    for e in [0.0, 0.3, 0.6, 0.9]:
+        tinf = math.sqrt(2 * h / g) * (1 + e) / (1 - e)
+        for frac in [0.37, 0.93, 1.3]:
+            for steps in [60, 1000]:
+                y, vy = bounce_state(h, e, frac * tinf)
+                n = f"settle_{h}_{e}_{frac}_{steps}".replace(".", "p")
+                exact(n, f"""name = "{n}"
+duration = {frac * tinf!r}
+dt = "1/{steps}"
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+radius = 0.25
+position = [1.0, {h + 0.25!r}]
+restitution = {e}
+[[walls]]
+name = "floor"
+from = [-20.0, 0.0]
+to = [20.0, 0.0]
+restitution = {e}
+""", [1.0, y + 0.25], [0.0, vy], 1e-7 * max(1.0, h))
+
+# drag: linear drag with a wind (across) and quadratic drag (a fall): the converged
+# reference must meet the closed forms (core's own step is second order).
+for m in [0.5, 2.0]:
+    for k in [0.1, 1.0, 5.0]:
+        c, T, wx, v0x = k / m, 3.0, 3.0, -1.0
+        vt = g / c
+        n = f"draglin_{m}_{k}".replace(".", "p")
+        exact(n, f"""name = "{n}"
+duration = {T}
+[world]
+gravity = [0.0, -{g}]
+wind = [{wx}, 0.0]
+[[bodies]]
+name = "b"
+radius = 0.1
+mass = {m}
+position = [0.0, 100.0]
+velocity = [{v0x}, 0.0]
+drag_linear = {k}
+""", [wx * T + (v0x - wx) * (1 - math.exp(-c * T)) / c, 100.0 - vt * (T - (1 - math.exp(-c * T)) / c)],
+              [wx + (v0x - wx) * math.exp(-c * T), -vt * (1 - math.exp(-c * T))], 1e-8 * 100, "reference")
+    for k2 in [0.01, 0.1, 1.0]:
+        T = 3.0
+        vt = math.sqrt(m * g / k2)
+        n = f"dragquad_{m}_{k2}".replace(".", "p")
+        exact(n, f"""name = "{n}"
+duration = {T}
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+radius = 0.1
+mass = {m}
+position = [0.0, 100.0]
+drag_quadratic = {k2}
+""", [0.0, 100.0 - vt * vt / g * math.log(math.cosh(g * T / vt))], [0.0, -vt * math.tanh(g * T / vt)],
+              1e-8 * 100, "reference")
+
+# slope: a ball at rest on a slope (a wall drawn down or up, or a surface), mu_k = 0.75
+# mu_s: held iff tan(theta) <= mu_s, else a = g (sin - mu_k cos).
+for deg in [10, 20, 30, 45, 60]:
+    for mus in [0.2, 0.5, 0.8]:
+        for how in ["wall", "wallrev", "surface"]:
+            muk, th, T, L, r = 0.75 * mus, math.radians(deg), 1.5, 40.0, 0.5
+            d = (math.cos(th), -math.sin(th))
+            p0 = (math.sin(th) * r, math.cos(th) * r)
+            a = 0.0 if math.tan(th) <= mus else g * (math.sin(th) - muk * math.cos(th))
+            s = 0.5 * a * T * T
+            A, B = (-L * d[0], -L * d[1]), (L * d[0], L * d[1])
+            if how == "wallrev":
+                A, B = B, A
+            mat = f"friction = {muk}\nstatic_friction = {mus}\nrestitution = 0.0\n"
+            if how == "surface":   # faces the left of its point order: downhill, left is up
+                geo = f"[[surfaces]]\nname = \"slope\"\npoints = [[{A[0]!r}, {A[1]!r}], [{B[0]!r}, {B[1]!r}]]\n" + mat
+            else:
+                geo = f"[[walls]]\nname = \"slope\"\nfrom = [{A[0]!r}, {A[1]!r}]\nto = [{B[0]!r}, {B[1]!r}]\n" + mat
+            n = f"slope_{deg}_{mus}_{how}".replace(".", "p")
+            exact(n, f"""name = "{n}"
+duration = {T}
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+radius = {r}
+position = [{p0[0]!r}, {p0[1]!r}]
+{mat}{geo}""", [p0[0] + s * d[0], p0[1] + s * d[1]], [a * T * d[0], a * T * d[1]], 1e-6)
+
+# thrust: a(v) = a0 - k v from a two-point table along a heading: v = (a0/k)(1 - e^-kt).
+for a0 in [1.0, 5.0]:
+    for kk in [0.2, 1.0]:
+        for deg in [0, 37]:
+            th, T, vinf = math.radians(deg), 4.0, a0 / kk
+            v = vinf * (1 - math.exp(-kk * T))
+            s = vinf * (T - (1 - math.exp(-kk * T)) / kk)
+            n = f"thrust_{a0}_{kk}_{deg}".replace(".", "p")
+            exact(n, f"""name = "{n}"
+duration = {T}
+[[bodies]]
+name = "b"
+radius = 0.5
+position = [0.0, 0.0]
+angle = {th!r}
+[bodies.thrust]
+speeds = [0.0, 40.0]
+accel = [{a0}, {a0 - kk * 40.0!r}]
+""", [s * math.cos(th), s * math.sin(th)], [v * math.cos(th), v * math.sin(th)], 1e-7 * max(1.0, s), "reference")
+
+# edge: a ball sliding off a table's end (v^2 >= g r: it flies off at once on the
+# projectile's path; the friction decelerates it up to the end). Slower ones turn about
+# the end point (core micro-bounces there, first order: `edge_slow`, only the reference
+# is judged: converged means within its convergence error of the turn).
+for v0 in [2.5, 3.0, 5.0]:
+    for mu in [0.0, 0.1, 0.3]:
+        for steps in [60, 240]:
+            for off in [0.0, 0.013]:
+                r, x0 = 0.5, -(1.0 + off)
+                vc2 = v0 * v0 - 2 * mu * g * abs(x0)
+                if vc2 < 1.02 * g * r:
+                    continue
+                vc = math.sqrt(vc2)
+                te = (v0 - vc) / (mu * g) if mu > 0 else abs(x0) / v0
+                s = 0.4
+                n = f"edge_{v0}_{mu}_{steps}_{int(off * 1000)}".replace(".", "p")
+                exact(n, f"""name = "{n}"
+duration = {te + s!r}
+dt = "1/{steps}"
+[world]
+gravity = [0.0, -{g}]
+[[bodies]]
+name = "b"
+radius = {r}
+position = [{x0}, {r}]
+velocity = [{v0}, 0.0]
+restitution = 0.0
+friction = {mu}
+[[walls]]
+name = "table"
+from = [-10.0, 0.0]
+to = [0.0, 0.0]
+restitution = 0.0
+friction = {mu}
+""", [vc * s, r - 0.5 * g * s * s], [vc, -g * s], 1e-8)
+import json
+json.dump(truth, open(os.path.join(out, "..", "truth.json"), "w"))
 EOF
 
 mkdir -p "$work/refuse"
@@ -209,7 +416,7 @@ if [ "$status" -ge 2 ]; then cat "$work/run.txt" >&2; echo "hunt: physval run ex
 
 set +e
 python3 - "$work/out/results.json" "$work/scenes" <<'EOF'
-import json, math, re, sys
+import json, math, os, re, sys
 runs = json.load(open(sys.argv[1]))["runs"]
 found = []
 def green(r):
@@ -250,6 +457,41 @@ for r in runs:
         for c in misses:
             if c["pass"] and c["value"] is not None and c["value"] > 0.1 * c["limit"] / 1e-6:
                 found.append(f"WRONG GREEN {sc} {eng}: {c['what']} off by {c['value']:.3g} passed")
+truth = json.load(open(os.path.join(sys.argv[2], "..", "truth.json")))
+def ref_final(sc):
+    path = os.path.join(sys.argv[2], "..", "out", "series", sc, "reference.csv")
+    if not os.path.exists(path):
+        return None
+    rows = [l.strip().split(",") for l in open(path) if l.strip()]
+    d = dict(zip(rows[0], map(float, rows[-1])))
+    return [d["x_b"], d["y_b"]]
+refs = {x["scenario"]: x for x in json.load(open(sys.argv[1]))["references"]}
+for r in runs:
+    sc, eng = r["scenario"], r["engine"]
+    t = truth.get(sc)
+    if t is None or r["status"] in ("unsupported", "error"):
+        continue
+    f = [b for b in r["final"] if b["body"] == "b"][0]
+    err = max(math.dist(f["position"], t["position"]), math.dist(f["velocity"], t["velocity"]))
+    if eng == "core" and t["judge"] == "core" and err > t["tol"]:
+        found.append(f"CORE WRONG {sc}: {err:.3g} off its closed form (tolerance {t['tol']:.3g}), status {r['status']}")
+    if eng == "core" and t["judge"] == "reference":
+        ref = refs.get(sc, {})
+        p = ref_final(sc)
+        if ref.get("converged") and p is not None:
+            e = math.dist(p, t["position"])
+            if e > max(t["tol"], 10 * ref["convergence_error"]):
+                found.append(f"CORE WRONG {sc}: the converged reference is {e:.3g} m off the closed form "
+                             f"(convergence error {ref['convergence_error']:.3g})")
+    # Every engine: its position divergence from the reference must see its miss.
+    ref = refs.get(sc, {})
+    pd = r["metrics"].get("position_divergence")
+    p = ref_final(sc)
+    if eng != "core" and ref.get("converged") and pd is not None and p is not None:
+        miss = math.dist(f["position"], t["position"]) - math.dist(p, t["position"])
+        if pd < 0.5 * miss - 1e-9:
+            found.append(f"WRONG METRIC {sc} {eng}: ends {miss:.3g} m further from the closed form than the "
+                         f"reference, position_divergence {pd:.3g}")
 for eng, by_width in drift.items():
     base = by_width.get(1)
     for w, d in sorted(by_width.items()):

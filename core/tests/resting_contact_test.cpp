@@ -114,11 +114,18 @@ TEST(CoreResting, KnockedOutSupportDropsTheStack) {
 
 TEST(CoreResting, RollsOffTheEndAndFalls) {
   // A ball sliding on a frictionless ledge leaves it and falls; it does not hang on.
+  // At 2 m/s, v^2 < g r: it turns about the ledge's end until N = 0, at
+  // cos(phi) = (v^2 / (g r) + 2) / 3, and leaves with vx = v' cos(phi), v'^2 = v^2 +
+  // 2 g r (1 - cos(phi)): 2.013449 m/s. (This test used to demand vx = 2 exactly, the
+  // answer of a ball that does not turn, which core gave by a round-off accident at the
+  // end point; table_edge_test.cpp has the whole story.) core turns it by
+  // micro-bounces, first order: 5e-5 m/s off at dt 1/60.
   Scene s = scene_of({circle("ball", {0.0, 5.5}, {2.0, 0.0})}, {wall("ledge", {-1.0, 5.0}, {1.0, 5.0})}, {0.0, -g});
   Sim sim(s);
   sim.run_until(2.0, 1.0 / 60.0);
+  const double r = 0.5, v = 2.0, c = (v * v / (g * r) + 2.0) / 3.0;
   EXPECT_LT(sim.state("ball").position.y, 0.0);
-  EXPECT_NEAR(sim.state("ball").velocity.x, 2.0, 1e-12);
+  EXPECT_NEAR(sim.state("ball").velocity.x, std::sqrt(v * v + 2.0 * g * r * (1.0 - c)) * c, 1e-4);
 }
 }  // namespace physval::test
 
