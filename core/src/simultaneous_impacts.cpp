@@ -17,8 +17,8 @@
 // kGapUlps ulps of the scene's coordinates (the round-off of the root of a gap
 // polynomial and of a few path advances), i.e. when its own impact, if any, is due
 // within round-off of t. Faces, bodies at rest or sliding on a face (leaves: with their
-// faces only) and friction take part; a scene with a collision matrix, points and
-// particles are left to the pairwise path.
+// faces only; one sliding on a frictionless face with its bodies too) and friction take
+// part; a scene with a collision matrix, points and particles are left to the pairwise path.
 //
 // With friction the set is solved by projected Jacobi, and every body's velocity change
 // is summed from its impulses in an order fixed by the geometry (exactly, for the
