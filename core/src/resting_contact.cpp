@@ -607,6 +607,14 @@ bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_
   return true;
 }
 
+// Body j slides on a frictionless face (a face support, not stuck): nothing but a hold
+// ever stops it, so a group's hold (and its pocket) takes it as a member.
+bool frictionless_slider(const World& w, std::uint32_t j) {
+  if (!w.supported(j) || w.on_body(j) || w.is_held(j) || w.stationary(j)) return false;
+  const PairMaterial m = w.pair_material(w.material[j], w.statics.segments[w.support[j]].material);
+  return m.friction == 0.0 && m.static_friction == 0.0;
+}
+
 bool try_hold_group(World& w, std::uint32_t seed, double t, double dt, const NearFn& near_fn,
                     std::vector<std::uint32_t>& members) {
   members.clear();
@@ -628,7 +636,9 @@ bool try_hold_group(World& w, std::uint32_t seed, double t, double dt, const Nea
     near_fn(pos[q], r + 1e-9 * (r + w.length_scale), buf);
     for (std::uint32_t j : buf) {
       if (j == m || !w.dynamic(j) || w.stationary(j)) continue;
-      if (w.supported(j) && !w.on_body(j)) continue;   // on a face: its own path
+      // On a face: its own path, unless it slides slowly on a frictionless face (nothing else
+      // ever stops it there: the group's hold is the limit of its collapse).
+      if (w.supported(j) && !w.on_body(j) && !(slow(j) && frictionless_slider(w, j))) continue;
       if ((w.flags[m] & kPoint) && (w.flags[j] & kPoint)) continue;
       if (((w.flags[m] | w.flags[j]) & kParticle) && related_bodies(w, m, j)) continue;
       if (w.any_rules && !w.response(w.group[m], w.group[j]).collide) continue;
@@ -772,7 +782,7 @@ bool try_hold_group_pocket(World& w, std::uint32_t seed, double t, double dt, co
       if (!pair_ok(m, j) || w.stationary(j)) continue;
       if (std::find(members.begin(), members.end(), j) != members.end()) continue;
       if (length(w.pos_at(j, t) - w.pos_at(m, t)) - (w.radius[m] + w.radius[j]) > reach) continue;
-      if (!w.dynamic(j) || w.supported(j) || !slow(j)) return false;
+      if (!w.dynamic(j) || (w.supported(j) && !frictionless_slider(w, j)) || !slow(j)) return false;
       members.push_back(j);
       if (members.size() > kMaxMembers) return false;
     }
