@@ -23,6 +23,8 @@
 #include <cmath>
 #include <numbers>
 #include <span>
+#include <tuple>
+#include <vector>
 
 #include "physval/core/time_of_impact.hpp"
 #include "world.hpp"
@@ -993,6 +995,138 @@ bool resting_component(World& w, const BodiesByX& bx, std::uint32_t seed, std::v
   return true;
 }
 
+// The least-squares contact forces of a component exactly: forces x >= 0 on its C columns
+// (column k: a force along d on member b, minus it on member a; a < 0: a fixed support)
+// minimising sum_q m_q |a_q|^2, a_q a member's force acceleration plus its forces over its
+// mass, i.e. min |B x - y| in mass-weighted form (B's rows sqrt(1/m) d, y = -sqrt(m) a).
+// Lawson and Hanson's active-set method; each unconstrained solve on the active columns by
+// Householder QR. False if it does not finish (3 C + 30 additions) or an active set is
+// singular.
+template <class ColFn>
+bool exact_least_squares(const World& w, std::span<const std::uint32_t> members, std::size_t C, ColFn col,
+                         std::vector<double>& x) {
+  const std::size_t M = members.size(), R = 2 * M;
+  std::vector<double> B(R * C, 0.0), y(R), z(C), wv(C), res(R);
+  const auto at = [&](std::size_t row, std::size_t k) -> double& { return B[k * R + row]; };
+  for (std::size_t k = 0; k < C; ++k) {
+    const auto [a, b, d] = col(k);
+    const double sb = std::sqrt(w.inv_mass[members[static_cast<std::size_t>(b)]]);
+    at(2 * static_cast<std::size_t>(b), k) += sb * d.x;
+    at(2 * static_cast<std::size_t>(b) + 1, k) += sb * d.y;
+    if (a >= 0) {
+      const double sa = std::sqrt(w.inv_mass[members[static_cast<std::size_t>(a)]]);
+      at(2 * static_cast<std::size_t>(a), k) -= sa * d.x;
+      at(2 * static_cast<std::size_t>(a) + 1, k) -= sa * d.y;
+    }
+  }
+  double ynorm = 0.0;
+  for (std::size_t q = 0; q < M; ++q) {
+    const double s = -1.0 / std::sqrt(w.inv_mass[members[q]]);
+    y[2 * q] = s * w.acc[members[q]].x;
+    y[2 * q + 1] = s * w.acc[members[q]].y;
+    ynorm = std::max({ynorm, std::fabs(y[2 * q]), std::fabs(y[2 * q + 1])});
+  }
+  x.assign(C, 0.0);
+  std::vector<char> active(C, 0);
+  std::vector<std::size_t> P;
+  std::vector<double> Q, rhs;
+  // z = the least-squares solution on the active columns (0 elsewhere); false if singular.
+  const auto solve = [&]() {
+    const std::size_t n = P.size();
+    Q.assign(R * n, 0.0);
+    for (std::size_t j = 0; j < n; ++j) {
+      for (std::size_t i = 0; i < R; ++i) Q[j * R + i] = at(i, P[j]);
+    }
+    rhs = y;
+    double scale = 0.0;
+    for (double v : Q) scale = std::max(scale, std::fabs(v));
+    for (std::size_t j = 0; j < n; ++j) {   // Householder on column j, rows j..R-1
+      if (j >= R) return false;
+      double norm = 0.0;
+      for (std::size_t i = j; i < R; ++i) norm += Q[j * R + i] * Q[j * R + i];
+      norm = std::sqrt(norm);
+      if (!(norm > 1e-13 * scale)) return false;
+      const double alpha = Q[j * R + j] > 0.0 ? -norm : norm;
+      std::vector<double> v(R - j);
+      for (std::size_t i = j; i < R; ++i) v[i - j] = Q[j * R + i];
+      v[0] -= alpha;
+      double vv = 0.0;
+      for (double e : v) vv += e * e;
+      if (!(vv > 0.0)) continue;
+      for (std::size_t jj = j; jj < n; ++jj) {
+        double s = 0.0;
+        for (std::size_t i = j; i < R; ++i) s += v[i - j] * Q[jj * R + i];
+        s *= 2.0 / vv;
+        for (std::size_t i = j; i < R; ++i) Q[jj * R + i] -= s * v[i - j];
+      }
+      double s = 0.0;
+      for (std::size_t i = j; i < R; ++i) s += v[i - j] * rhs[i];
+      s *= 2.0 / vv;
+      for (std::size_t i = j; i < R; ++i) rhs[i] -= s * v[i - j];
+    }
+    std::fill(z.begin(), z.end(), 0.0);
+    for (std::size_t j = n; j-- > 0;) {
+      double s = rhs[j];
+      for (std::size_t jj = j + 1; jj < n; ++jj) s -= Q[jj * R + j] * z[P[jj]];
+      z[P[j]] = s / Q[j * R + j];
+    }
+    return true;
+  };
+  const auto gradient = [&]() {   // wv = B^T (y - B x)
+    res = y;
+    for (std::size_t k = 0; k < C; ++k) {
+      if (x[k] == 0.0) continue;
+      for (std::size_t i = 0; i < R; ++i) res[i] -= at(i, k) * x[k];
+    }
+    for (std::size_t k = 0; k < C; ++k) {
+      double s = 0.0;
+      for (std::size_t i = 0; i < R; ++i) s += at(i, k) * res[i];
+      wv[k] = s;
+    }
+  };
+  gradient();
+  for (std::size_t outer = 0; outer < 3 * C + 30; ++outer) {
+    std::size_t t = C;
+    double best = 1e-13 * ynorm;
+    for (std::size_t k = 0; k < C; ++k) {
+      if (!active[k] && wv[k] > best) {
+        best = wv[k];
+        t = k;
+      }
+    }
+    if (t == C) return true;   // no column would lower the residual: optimal
+    active[t] = 1;
+    P.push_back(t);
+    for (int inner = 0;; ++inner) {
+      if (inner > static_cast<int>(C) + 10 || !solve()) return false;
+      bool positive = true;
+      for (std::size_t k : P) positive = positive && z[k] > 0.0;
+      if (positive) {
+        for (std::size_t k : P) x[k] = z[k];
+        break;
+      }
+      double alpha = 1.0;
+      for (std::size_t k : P) {
+        if (z[k] <= 0.0) alpha = std::min(alpha, x[k] / (x[k] - z[k]));
+      }
+      for (std::size_t k : P) x[k] += alpha * (z[k] - x[k]);
+      std::vector<std::size_t> keep;
+      for (std::size_t k : P) {
+        if (x[k] > 0.0) {
+          keep.push_back(k);
+        } else {
+          x[k] = 0.0;
+          active[k] = 0;
+        }
+      }
+      P = keep;
+      if (P.empty()) break;
+    }
+    gradient();
+  }
+  return false;
+}
+
 // Whether a resting component (sorted members; faces and static bodies fixed) can be held
 // by rigid Coulomb contact: a normal force >= 0 at every contact and a static friction
 // force within mu times it, every member's acceleration zero. The tolerances of
@@ -1001,6 +1135,7 @@ bool resting_component(World& w, const BodiesByX& bx, std::uint32_t seed, std::v
 // member taken as fixed. kCannotHold only with a certificate (below), else kUndecided.
 // `residual`: the largest acceleration left on a member by Gauss-Seidel.
 enum class Verdict { kHeld, kCannotHold, kUndecided };
+constexpr std::size_t kMaxExact = 256;   // columns and members an exact solve takes on
 
 Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint32_t> members, double& residual) {
   thread_local std::vector<std::pair<std::uint32_t, Vec2>> touch;
@@ -1188,15 +1323,7 @@ Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint
   // force acceleration) while the forces do positive work along them (they are the least
   // mass-weighted residual, so their work is its square): a motion the contacts allow and
   // the forces drive. Else Gauss-Seidel has not converged and nothing is certain.
-  double worst = INFINITY;
-  for (std::size_t k = 0; k < C; ++k) {
-    const Col& c = cols[k];
-    const Vec2 aa = c.a < 0 ? Vec2{} : acc[static_cast<std::size_t>(c.a)];
-    worst = std::min(worst, dot(acc[static_cast<std::size_t>(c.b)] - aa, c.d) / length(c.d));
-  }
-  double work = 0.0;
-  for (std::size_t q = 0; q < M; ++q) work += dot(w.acc[members[q]], acc[q]) / inv(static_cast<std::int32_t>(q));
-  if (!(worst >= -1e-12 * amax && work > 0.0)) return Verdict::kUndecided;
+  //
   // The certificate is a motion: the members' accelerations under the least-squares forces,
   // which for frictionless contacts are rigid contact's own (Gauss's principle: a force >= 0
   // only where the pair's normal acceleration is 0, and >= 0 everywhere). It shows a hold
@@ -1208,31 +1335,70 @@ Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint
   // is at rest: the holds are justified. (A ball falling past a held stack, touching its side
   // within 1e-9 on the way, was reported as the stack's hold failing: 9.8 m/s^2 left on the
   // falling ball, none on the stack.)
-  force_sum.assign(M, 0.0);
-  for (std::size_t k = 0; k < C; ++k) {
-    const double f = lam[k] * length(cols[k].d);
-    if (cols[k].a >= 0) force_sum[static_cast<std::size_t>(cols[k].a)] += f * inv(cols[k].a);
-    force_sum[static_cast<std::size_t>(cols[k].b)] += f * inv(cols[k].b);
-  }
-  const auto moves = [&](std::int32_t q) {   // the certificate moves member q
-    if (q < 0) return false;
-    const auto u = static_cast<std::size_t>(q);
-    return length(acc[u]) > 1e-9 * length(w.acc[members[u]]) + 64.0 * 2.220446049250313e-16 * force_sum[u];
+  // `exact`: forces from an exact least-squares solve (below), whose round-off is that of
+  // summing them: a relative acceleration along an edge >= -64 eps x the forces' accelerations
+  // on its bodies counts as >= 0 there, as a member within that round-off is at rest.
+  const auto verdict_of = [&](std::span<const Vec2> a, std::span<const double> l, bool exact) {
+    force_sum.assign(M, 0.0);
+    for (std::size_t k = 0; k < C; ++k) {
+      const double f = std::fabs(l[k]) * length(cols[k].d);
+      if (cols[k].a >= 0) force_sum[static_cast<std::size_t>(cols[k].a)] += f * inv(cols[k].a);
+      force_sum[static_cast<std::size_t>(cols[k].b)] += f * inv(cols[k].b);
+    }
+    const auto slack = [&](std::int32_t x) { return x < 0 ? 0.0 : 64.0 * 2.220446049250313e-16 * force_sum[static_cast<std::size_t>(x)]; };
+    const auto rel = [&](const Col& c) {
+      const Vec2 aa = c.a < 0 ? Vec2{} : a[static_cast<std::size_t>(c.a)];
+      return dot(a[static_cast<std::size_t>(c.b)] - aa, c.d) / length(c.d);
+    };
+    double work = 0.0;
+    for (std::size_t q = 0; q < M; ++q) work += dot(w.acc[members[q]], a[q]) / inv(static_cast<std::int32_t>(q));
+    if (!(work > 0.0)) return Verdict::kUndecided;
+    for (const Col& c : cols) {
+      if (!(rel(c) >= -1e-12 * amax - (exact ? slack(c.a) + slack(c.b) : 0.0))) return Verdict::kUndecided;
+    }
+    const auto moves = [&](std::int32_t q) {   // the certificate moves member q
+      if (q < 0) return false;
+      const auto u = static_cast<std::size_t>(q);
+      return length(a[u]) > 1e-9 * length(w.acc[members[u]]) + slack(q);
+    };
+    for (std::size_t q = 0; q < M; ++q) {
+      const std::uint32_t m = members[q];
+      if (moves(static_cast<std::int32_t>(q)) && (w.is_held(m) || w.stationary(m))) return Verdict::kCannotHold;
+    }
+    for (std::size_t k = 0; k < C; ++k) {
+      const Col& c = cols[k];
+      if (!(l[k] > 0.0) || !(moves(c.a) || moves(c.b))) continue;
+      if (c.edge) return Verdict::kCannotHold;
+      // A frictionless force on a moving member: its pair's normal acceleration 0 (to the
+      // at-rest bound), else the force pushes bodies that part and is no solution.
+      if (rel(c) > 1e-9 * amax) return Verdict::kCannotHold;
+    }
+    return Verdict::kHeld;
   };
-  for (std::size_t q = 0; q < M; ++q) {
-    const std::uint32_t m = members[q];
-    if (moves(static_cast<std::int32_t>(q)) && (w.is_held(m) || w.stationary(m))) return Verdict::kCannotHold;
+  const Verdict v = verdict_of(acc, lam, false);
+  if (v != Verdict::kUndecided || C > kMaxExact || M > kMaxExact) return v;
+  // Gauss-Seidel had not converged (forces 1e7 times the weights, at contacts 1e-7 rad off
+  // the horizontal, crawl): the least-squares forces exactly (Lawson-Hanson's active set,
+  // each solve by Householder QR), and the same verdict on them.
+  thread_local std::vector<double> x;
+  thread_local std::vector<Vec2> acc2;
+  if (!exact_least_squares(w, members, C, [&](std::size_t k) { return std::tuple(cols[k].a, cols[k].b, cols[k].d); }, x)) {
+    return Verdict::kUndecided;
   }
+  acc2.resize(M);
+  for (std::size_t q = 0; q < M; ++q) acc2[q] = w.acc[members[q]];
   for (std::size_t k = 0; k < C; ++k) {
     const Col& c = cols[k];
-    if (!(lam[k] > 0.0) || !(moves(c.a) || moves(c.b))) continue;
-    if (c.edge) return Verdict::kCannotHold;
-    // A frictionless force on a moving member: its pair's normal acceleration 0 (to the
-    // at-rest bound), else the force pushes bodies that part and is no solution.
-    const Vec2 aa = c.a < 0 ? Vec2{} : acc[static_cast<std::size_t>(c.a)];
-    if (dot(acc[static_cast<std::size_t>(c.b)] - aa, c.d) > 1e-9 * amax) return Verdict::kCannotHold;
+    if (x[k] == 0.0) continue;
+    if (c.a >= 0) acc2[static_cast<std::size_t>(c.a)] -= (x[k] * inv(c.a)) * c.d;
+    acc2[static_cast<std::size_t>(c.b)] += (x[k] * inv(c.b)) * c.d;
   }
-  return Verdict::kHeld;
+  const Verdict ve = verdict_of(acc2, x, true);
+  if (ve == Verdict::kCannotHold) {
+    residual = 0.0;
+    for (std::size_t q = 0; q < M; ++q) residual = std::max(residual, length(acc2[q]));
+  }
+  return ve;
 }
 
 }  // namespace
