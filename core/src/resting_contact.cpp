@@ -1335,9 +1335,10 @@ Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint
   // is at rest: the holds are justified. (A ball falling past a held stack, touching its side
   // within 1e-9 on the way, was reported as the stack's hold failing: 9.8 m/s^2 left on the
   // falling ball, none on the stack.)
-  // `exact`: forces from an exact least-squares solve (below), whose round-off is that of
-  // summing them: a relative acceleration along an edge >= -64 eps x the forces' accelerations
-  // on its bodies counts as >= 0 there, as a member within that round-off is at rest.
+  // `exact`: forces from an exact least-squares solve (below), accurate to the round-off of
+  // its largest forces (Householder QR is backward stable): a relative acceleration along an
+  // edge >= -64 eps x the largest force acceleration on a member counts as >= 0 there. (A
+  // member is at rest within the round-off of its own forces, as above: stricter.)
   const auto verdict_of = [&](std::span<const Vec2> a, std::span<const double> l, bool exact) {
     force_sum.assign(M, 0.0);
     for (std::size_t k = 0; k < C; ++k) {
@@ -1350,11 +1351,13 @@ Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint
       const Vec2 aa = c.a < 0 ? Vec2{} : a[static_cast<std::size_t>(c.a)];
       return dot(a[static_cast<std::size_t>(c.b)] - aa, c.d) / length(c.d);
     };
+    double solve_slack = 0.0;   // an exact solve's round-off: that of its largest forces
+    for (std::size_t q = 0; q < M; ++q) solve_slack = std::max(solve_slack, slack(static_cast<std::int32_t>(q)));
     double work = 0.0;
     for (std::size_t q = 0; q < M; ++q) work += dot(w.acc[members[q]], a[q]) / inv(static_cast<std::int32_t>(q));
     if (!(work > 0.0)) return Verdict::kUndecided;
     for (const Col& c : cols) {
-      if (!(rel(c) >= -1e-12 * amax - (exact ? slack(c.a) + slack(c.b) : 0.0))) return Verdict::kUndecided;
+      if (!(rel(c) >= -1e-12 * amax - (exact ? solve_slack : 0.0))) return Verdict::kUndecided;
     }
     const auto moves = [&](std::int32_t q) {   // the certificate moves member q
       if (q < 0) return false;
