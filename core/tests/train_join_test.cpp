@@ -74,6 +74,7 @@ struct Case {
   double vs, vt;               // the striker's and the train's speeds at the start
   bool reversed;               // bodies listed front first
   double deg = 0.0;            // down a slope of so many degrees
+  bool mirrored = false;       // on a floor, towards -x
 };
 
 std::string describe(const Case& c) {
@@ -82,7 +83,7 @@ std::string describe(const Case& c) {
   s += " mu";
   for (double x : c.mu) s += " " + std::to_string(x);
   return s + " vs " + std::to_string(c.vs) + " vt " + std::to_string(c.vt) + (c.reversed ? " reversed" : "") + " " +
-         std::to_string(c.deg) + " deg";
+         std::to_string(c.deg) + " deg" + (c.mirrored ? " mirrored" : "");
 }
 
 // Runs one case; false if it is not one (the train parts before, or is never caught).
@@ -91,7 +92,8 @@ bool judge(const Case& c) {
   const double r = 0.5, gap = 0.3;
   const double th = c.deg * std::numbers::pi / 180.0;
   const Slope sl{std::sin(th), std::cos(th)};
-  const Vec2 dn{std::cos(th), -std::sin(th)}, up{std::sin(th), std::cos(th)};   // down the slope, off it
+  const Vec2 dn = c.mirrored ? Vec2{-1.0, 0.0} : Vec2{std::cos(th), -std::sin(th)};   // down the slope
+  const Vec2 up{std::sin(th), std::cos(th)};                                           // off it
   std::vector<double> tm(c.m.begin() + 1, c.m.end()), tmu(c.mu.begin() + 1, c.mu.end());
   const std::vector<Block> train = pool(tm, tmu, sl);
   if (train.size() != 1) return false;   // the train parts at once
@@ -173,10 +175,11 @@ TEST(CoreTrainJoin, ABallStruckIntoTwoTouchingBallsMovesOnAsTheClosedFormSays) {
     for (const auto& m : std::vector<std::vector<double>>{{1.0, 1.0, 1.0}, {3.0, 1.0, 1.0}, {1.0, 3.0, 0.5}, {0.2, 1.0, 5.0}, {10.0, 0.1, 1.0}}) {
       for (const auto& [vs, vt] : std::vector<std::pair<double, double>>{{2.0, 0.5}, {5.0, 0.5}, {3.0, 0.0}, {6.0, 2.0}}) {
         for (bool reversed : {false, true}) judged += judge({m, mu, vs, vt, reversed}) ? 1 : 0;
+        judged += judge({m, mu, vs, vt, false, 0.0, true}) ? 1 : 0;
       }
     }
   }
-  EXPECT_EQ(judged, 236);
+  EXPECT_EQ(judged, 354);
 }
 
 TEST(CoreTrainJoin, ABallStruckIntoThreeTouchingBallsMovesOnAsTheClosedFormSays) {
@@ -185,10 +188,11 @@ TEST(CoreTrainJoin, ABallStruckIntoThreeTouchingBallsMovesOnAsTheClosedFormSays)
     for (const auto& m : std::vector<std::vector<double>>{{1.0, 1.0, 1.0, 1.0}, {3.0, 1.0, 2.0, 1.0}, {0.5, 2.0, 1.0, 4.0}, {10.0, 0.1, 1.0, 0.3}}) {
       for (const auto& [vs, vt] : std::vector<std::pair<double, double>>{{2.0, 0.5}, {5.0, 0.5}, {3.0, 0.0}, {6.0, 2.0}}) {
         for (bool reversed : {false, true}) judged += judge({m, mu, vs, vt, reversed}) ? 1 : 0;
+        judged += judge({m, mu, vs, vt, false, 0.0, true}) ? 1 : 0;
       }
     }
   }
-  EXPECT_EQ(judged, 164);
+  EXPECT_EQ(judged, 246);
 }
 
 TEST(CoreTrainJoin, DownASlopeABallStruckIntoTwoOrThreeTouchingBallsMovesOnAsTheClosedFormSays) {
