@@ -612,6 +612,18 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     bool tangent;
   };
   thread_local std::vector<SweepRow> sweep;
+  struct SweepTerm {
+    Vec2 d;   // sign * the row's direction
+    std::uint32_t row, glen;
+    double sign;
+  };
+  struct SweepBody {
+    double m;
+    std::uint32_t s, t0, t1;
+  };
+  thread_local std::vector<SweepTerm> sweep_term;
+  thread_local std::vector<SweepBody> sweep_body;
+  thread_local std::vector<Vec2> sweep_dv;
   if (friction) {
     // Row k's step omega_k: Gershgorin on 2 D / Omega - A, which stays positive definite
     // (so the damped sweep converges) when (2 / omega_k - 1) A_kk > S_k = sum over l != k
@@ -641,7 +653,6 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       const double akk = A[k];
       if (akk > 0.0) omega[k] = std::min(1.0, 0.95 * (2.0 * akk) / (akk + S));
     }
-    pnew.assign(R, 0.0);
   }
   // law 0: Newton's law at the normals, friction against the tangential velocity after
   // the impact; law 1: Moreau's law, friction against w_t+ + e w_t- (the tangential
@@ -667,32 +678,99 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       q.mu = c.mu_s;
       q.target = rk.tangent ? (law == 1 ? c.e * w0[k] : 0.0) : (law == 2 ? 0.0 : c.target);
     }
+    // The sweeps run on local copies laid out for them (the same arithmetic as
+    // recompute_dv(false) and the rows above, so the same iterates to the last bit): each
+    // body's velocity change in sweep_dv, with one extra slot that stays zero for the
+    // faces' side of a row; each movable body's terms packed in their summing order.
+    const std::size_t nb = bodies.size();
+    sweep_dv.assign(nb + 1, Vec2{});
+    for (SweepRow& q : sweep) {
+      if (q.sa < 0) q.sa = static_cast<std::int32_t>(nb);
+      if (q.sb < 0) q.sb = static_cast<std::int32_t>(nb);
+    }
+    sweep_body.clear();
+    sweep_term.clear();
+    for (std::size_t s = 0; s < nb; ++s) {
+      const double m = slot_inv[s];
+      if (!(m > 0.0)) continue;   // its velocity change stays 0
+      const std::uint32_t t0 = static_cast<std::uint32_t>(sweep_term.size());
+      for (std::uint32_t f = term_start[s]; f < term_start[s + 1]; ++f) {
+        sweep_term.push_back({term_d[f], term_row[f], term_glen[f], term_sign[f]});
+      }
+      sweep_body.push_back({m, static_cast<std::uint32_t>(s), t0, static_cast<std::uint32_t>(sweep_term.size())});
+    }
+    pnew.assign(R, 0.0);
+    double* pc = p.data();
+    double* pq = pnew.data();
+    bool swapped = false;
+    const SweepRow* const sw = sweep.data();
+    Vec2* const sdv = sweep_dv.data();
+    const SweepTerm* const st = sweep_term.data();
+    double pm = pmax;
     for (int iter = 0; iter < max_iter; ++iter) {
       double change = 0.0;
       for (std::size_t k = 0; k < R; ++k) {
-        const SweepRow& q = sweep[k];
-        const double pk = p[k];
+        const SweepRow& q = sw[k];
+        const double pk = pc[k];
         double pn = pk;
         if (q.akk > 0.0) {
-          const Vec2 da = q.sa >= 0 ? dv[static_cast<std::size_t>(q.sa)] : Vec2{};
-          const Vec2 db = q.sb >= 0 ? dv[static_cast<std::size_t>(q.sb)] : Vec2{};
+          const Vec2 da = sdv[q.sa];
+          const Vec2 db = sdv[q.sb];
           const double wk = q.w0 + dot(db - da, q.d);
           if (q.tangent) {
-            const double bound = q.mu * p[k - 1];
+            const double bound = q.mu * pc[k - 1];
             const double xi = wk + q.target;   // law 1: w_t+ + e w_t-; else + 0 (exact)
             pn = std::clamp(pk - q.omega * xi / q.akk, -bound, bound);
           } else {
             pn = std::max(0.0, pk + q.omega * (q.target - wk) / q.akk);
           }
         }
-        pnew[k] = pn;
+        pq[k] = pn;
         change = std::max(change, std::fabs(pn - pk));
-        pmax = std::max(pmax, std::fabs(pn));
+        pm = std::max(pm, std::fabs(pn));
       }
-      p.swap(pnew);
-      recompute_dv(false);
-      if (change <= stop * pmax) break;
+      std::swap(pc, pq);
+      swapped = !swapped;
+      // The velocity changes of the last sweep are not needed: recompute_dv(true) below.
+      if (change <= stop * pm) break;
+      for (const SweepBody& bt : sweep_body) {
+        const double m = bt.m;
+        double sx = 0.0, sy = 0.0;
+        for (std::uint32_t f = bt.t0; f < bt.t1;) {
+          const SweepTerm& t0 = st[f];
+          const std::uint32_t g = t0.glen;
+          double gx, gy;
+          if (g == 1) {
+            const double imp = pc[t0.row] * m;
+            gx = imp * t0.d.x;
+            gy = imp * t0.d.y;
+          } else if (g == 2) {
+            const SweepTerm& t1 = st[f + 1];
+            const double q0 = pc[t0.row] * m, q1 = pc[t1.row] * m;
+            gx = q0 * t0.d.x + q1 * t1.d.x;
+            gy = q0 * t0.d.y + q1 * t1.d.y;
+          } else {
+            sum_x.resize(g);
+            sum_y.resize(g);
+            for (std::uint32_t h = 0; h < g; ++h) {
+              const SweepTerm& th = st[f + h];
+              const Vec2 d = rows[th.row].d;
+              const double imp = th.sign * (pc[th.row] * m);
+              sum_x[h] = imp * d.x;
+              sum_y[h] = imp * d.y;
+            }
+            gx = exact_sum(sum_x.data(), g);
+            gy = exact_sum(sum_y.data(), g);
+          }
+          sx += gx;
+          sy += gy;
+          f += g;
+        }
+        sdv[bt.s] = {sx, sy};
+      }
     }
+    pmax = pm;
+    if (swapped) p.swap(pnew);
     // A contact whose friction could not stop it slides: kinetic friction, mu_k p_n.
     for (std::size_t k = 0; k < R; ++k) {
       const Row& rk = rows[k];
