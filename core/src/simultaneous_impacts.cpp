@@ -622,6 +622,12 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     std::uint32_t s, t0, t1;
   };
   thread_local std::vector<SweepTerm> sweep_term;
+  struct SweepPair {
+    Vec2 dn, dt;
+    double w0n, w0t, omn, omt, akk, mu, targetn, targett;
+    std::int32_t sa, sb;
+  };
+  thread_local std::vector<SweepPair> sweep_pair;
   thread_local std::vector<SweepBody> sweep_body;
   thread_local std::vector<Vec2> sweep_dv;
   if (friction) {
@@ -707,9 +713,42 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     Vec2* const sdv = sweep_dv.data();
     const SweepTerm* const st = sweep_term.data();
     double pm = pmax;
+    // Every contact with friction (the common case): its normal row and its tangent row
+    // (the next one) read the same two bodies and share A_kk, so they are updated
+    // together, each exactly as below.
+    const bool paired = R == 2 * K;
+    if (paired) {
+      sweep_pair.resize(K);
+      for (std::size_t j = 0; j < K; ++j) {
+        const SweepRow& qn = sw[2 * j];
+        const SweepRow& qt = sw[2 * j + 1];
+        sweep_pair[j] = {qn.d, qt.d, qn.w0, qt.w0, qn.omega, qt.omega, qn.akk, qt.mu, qn.target, qt.target, qn.sa, qn.sb};
+      }
+    }
+    const SweepPair* const sp = sweep_pair.data();
     for (int iter = 0; iter < max_iter; ++iter) {
       double change = 0.0;
-      for (std::size_t k = 0; k < R; ++k) {
+      for (std::size_t j = 0; paired && j < K; ++j) {
+        const SweepPair& q = sp[j];
+        const double pkn = pc[2 * j], pkt = pc[2 * j + 1];
+        double pnn = pkn, pnt = pkt;
+        if (q.akk > 0.0) {
+          const Vec2 dd = sdv[q.sb] - sdv[q.sa];
+          const double wkn = q.w0n + dot(dd, q.dn);
+          const double wkt = q.w0t + dot(dd, q.dt);
+          pnn = std::max(0.0, pkn + q.omn * (q.targetn - wkn) / q.akk);
+          const double bound = q.mu * pkn;
+          const double xi = wkt + q.targett;   // law 1: w_t+ + e w_t-; else + 0 (exact)
+          pnt = std::clamp(pkt - q.omt * xi / q.akk, -bound, bound);
+        }
+        pq[2 * j] = pnn;
+        pq[2 * j + 1] = pnt;
+        change = std::max(change, std::fabs(pnn - pkn));
+        pm = std::max(pm, std::fabs(pnn));
+        change = std::max(change, std::fabs(pnt - pkt));
+        pm = std::max(pm, std::fabs(pnt));
+      }
+      for (std::size_t k = 0; !paired && k < R; ++k) {
         const SweepRow& q = sw[k];
         const double pk = pc[k];
         double pn = pk;
