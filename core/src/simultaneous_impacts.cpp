@@ -118,9 +118,12 @@ struct Contact {
 };
 
 // Whether bodies i and j touch at t and are closing or at rest; fills the contact.
-bool touching(const World& w, std::uint32_t i, std::uint32_t j, double t, Contact& c) {
-  if (i > j) std::swap(i, j);
-  const Vec2 pi = pos_now(w, i, t), pj = pos_now(w, j, t);
+// pi, pj: pos_now(w, i, t) and pos_now(w, j, t).
+bool touching(const World& w, std::uint32_t i, std::uint32_t j, Vec2 pi, Vec2 pj, double t, Contact& c) {
+  if (i > j) {
+    std::swap(i, j);
+    std::swap(pi, pj);
+  }
   const Vec2 d = pj - pi;
   const double R = w.radius[i] + w.radius[j];
   const double dl = length(d);
@@ -242,14 +245,25 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       contacts.push_back(c);
     };
     // Adds contact (i, j) if the two touch; false if the set must go pair by pair.
+    // A pair already in the set is passed over before its geometry is looked at (the
+    // same outcome: it was not added again either way). Positions at t are looked up
+    // once per body i (nothing moves while the set is gathered).
+    std::uint32_t pos_of = kNone;
+    Vec2 pos_i{};
+    Contact scratch;   // touching() and add() set every field they read
     const auto consider = [&](std::uint32_t i, std::uint32_t j) {
       if (j == i || !eligible(j)) return true;
       if (fixed(w, i, fixed_rest) && fixed(w, j, fixed_rest)) return true;
-      Contact c;
-      if (!touching(w, i, j, t, c)) return true;
+      const std::uint32_t lo = std::min(i, j), hi = std::max(i, j);
       const bool known = std::any_of(contacts.begin(), contacts.end(),
-                                     [&](const Contact& k) { return k.a == c.a && k.b == c.b; });
+                                     [&](const Contact& k) { return k.a == lo && k.b == hi; });
       if (known) return true;
+      if (pos_of != i) {
+        pos_i = pos_now(w, i, t);
+        pos_of = i;
+      }
+      Contact& c = scratch;
+      if (!touching(w, i, j, pos_i, pos_now(w, j, t), t, c)) return true;
       const PairMaterial m = w.pair_material(w.material[c.a], w.material[c.b]);
       add(c, m.restitution, m.static_friction, m.friction);
       if (contacts.size() > kMaxContacts) return false;
