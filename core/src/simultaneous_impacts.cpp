@@ -719,6 +719,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       }
       sweep_body.push_back({m, static_cast<std::uint32_t>(s), t0, static_cast<std::uint32_t>(sweep_term.size())});
     }
+    const bool singles = std::all_of(sweep_term.begin(), sweep_term.end(), [](const SweepTerm& x) { return x.glen == 1; });
     pnew.assign(R, 0.0);
     double* pc = p.data();
     double* pq = pnew.data();
@@ -786,6 +787,20 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       swapped = !swapped;
       // The velocity changes of the last sweep are not needed: recompute_dv(true) below.
       if (change <= stop * pm) break;
+      if (singles) {
+        // No group of equal keys: each term is a group of one (the branch below, g == 1).
+        for (const SweepBody& bt : sweep_body) {
+          const double m = bt.m;
+          double sx = 0.0, sy = 0.0;
+          for (std::uint32_t f = bt.t0; f < bt.t1; ++f) {
+            const double imp = pc[st[f].row] * m;
+            sx += imp * st[f].d.x;
+            sy += imp * st[f].d.y;
+          }
+          sdv[bt.s] = {sx, sy};
+        }
+        continue;
+      }
       for (const SweepBody& bt : sweep_body) {
         const double m = bt.m;
         double sx = 0.0, sy = 0.0;
