@@ -542,56 +542,21 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     term_d.resize(term_row.size());
     for (std::size_t f = 0; f < term_row.size(); ++f) term_d[f] = term_sign[f] * rows[term_row[f]].d;
   }
-  // dv from the impulses p: each body's terms summed in the order above (exactly = false,
-  // the sweeps) or exactly (exact_sum: the correctly rounded sum, for the velocities
-  // applied and the energy check). Either is the same whatever order the rows are in,
+  // dv from the impulses p: each body's terms summed exactly (exact_sum: the correctly
+  // rounded sum, for the velocities applied and the energy check); the sweeps sum them in
+  // the order above (friction_solve). Either is the same whatever order the rows are in,
   // and exactly mirrored in a mirrored scene.
   // Each body's inverse mass in this impact (0 for one that cannot move), looked up once:
   // the sweeps read it for every body in every sweep.
   thread_local std::vector<double> slot_inv;
   slot_inv.resize(bodies.size());
   for (std::size_t s = 0; s < bodies.size(); ++s) slot_inv[s] = inv(bodies[s]);
-  const auto recompute_dv = [&](bool exactly) {
+  const auto recompute_dv = [&]() {
     for (std::size_t s = 0; s < bodies.size(); ++s) {
       const std::uint32_t b0 = term_start[s], b1 = term_start[s + 1];
       const double m = slot_inv[s];
       if (!(m > 0.0)) {
         dv[s] = {};
-        continue;
-      }
-      if (!exactly) {
-        // term_d = sign * d, so (p m) term_d is sign (p m) d exactly (the sign is +-1).
-        double sx = 0.0, sy = 0.0;
-        for (std::uint32_t f = b0; f < b1;) {
-          const std::uint32_t g = term_glen[f];
-          double gx, gy;
-          if (g == 1) {
-            const Vec2 d = term_d[f];
-            const double imp = p[term_row[f]] * m;
-            gx = imp * d.x;
-            gy = imp * d.y;
-          } else if (g == 2) {
-            const Vec2 d0 = term_d[f], d1 = term_d[f + 1];
-            const double q0 = p[term_row[f]] * m, q1 = p[term_row[f + 1]] * m;
-            gx = q0 * d0.x + q1 * d1.x;
-            gy = q0 * d0.y + q1 * d1.y;
-          } else {
-            sum_x.resize(g);
-            sum_y.resize(g);
-            for (std::uint32_t h = 0; h < g; ++h) {
-              const Vec2 d = rows[term_row[f + h]].d;
-              const double imp = term_sign[f + h] * (p[term_row[f + h]] * m);
-              sum_x[h] = imp * d.x;
-              sum_y[h] = imp * d.y;
-            }
-            gx = exact_sum(sum_x.data(), g);
-            gy = exact_sum(sum_y.data(), g);
-          }
-          sx += gx;
-          sy += gy;
-          f += g;
-        }
-        dv[s] = {sx, sy};
         continue;
       }
       // Only the rows with an impulse (most are often 0): a body with two pays a plain sum.
@@ -616,7 +581,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   // Jacobi: every row is updated from the same velocities, with its step damped by
   // omega_k (below: a Gershgorin bound, which keeps the sweep stable),
   // and tangential impulses kept within mu_s p_n; the velocities are then summed again
-  // from all the impulses (recompute_dv). Renumbering the bodies permutes the rows and
+  // from all the impulses. Renumbering the bodies permutes the rows and
   // nothing else, and a mirrored scene gives exactly the mirrored iterates.
   thread_local std::vector<double> omega, pnew;
   struct SweepRow {
@@ -698,10 +663,10 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       q.mu = c.mu_s;
       q.target = rk.tangent ? (law == 1 ? c.e * w0[k] : 0.0) : (law == 2 ? 0.0 : c.target);
     }
-    // The sweeps run on local copies laid out for them (the same arithmetic as
-    // recompute_dv(false) and the rows above, so the same iterates to the last bit): each
-    // body's velocity change in sweep_dv, with one extra slot that stays zero for the
-    // faces' side of a row; each movable body's terms packed in their summing order.
+    // The sweeps run on local copies laid out for them: each body's velocity change in
+    // sweep_dv, with one extra slot that stays zero for the faces' side of a row; each
+    // movable body's terms packed in their summing order (groups of equal keys first by
+    // themselves; term d = sign * the row's d, so (p m) d there is sign (p m) d exactly).
     const std::size_t nb = bodies.size();
     sweep_dv.assign(nb + 1, Vec2{});
     for (SweepRow& q : sweep) {
@@ -785,7 +750,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       }
       std::swap(pc, pq);
       swapped = !swapped;
-      // The velocity changes of the last sweep are not needed: recompute_dv(true) below.
+      // The velocity changes of the last sweep are not needed: recompute_dv() below.
       if (change <= stop * pm) break;
       if (singles) {
         // No group of equal keys: each term is a group of one (the branch below, g == 1).
@@ -848,7 +813,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
         p[k] = std::copysign(c.mu_k * p[k - 1], p[k]);
       }
     }
-    recompute_dv(true);
+    recompute_dv();
   };
   // Whether the impulses p raise the set's kinetic energy (beyond round-off), summed
   // exactly so that the answer does not depend on the numbering either.
@@ -919,7 +884,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   }
   // Each body's velocity change summed exactly from all its impulses (a friction set's
   // friction_solve has just done so).
-  if (!friction) recompute_dv(true);
+  if (!friction) recompute_dv();
   for (std::size_t s = 0; s < bodies.size(); ++s) {
     if (inv(bodies[s]) > 0.0) w.vel[bodies[s]] += dv[s];
   }
