@@ -231,7 +231,7 @@ TEST(CoreTrainJoin, RowsOfBallsOnAFloorDoNotDependOnTheStep) {
     state = state * 6364136223846793005ULL + 1442695040888963407ULL;
     return static_cast<double>(state >> 11) * 0x1.0p-53;
   };
-  const auto pick = [&](std::vector<double> xs) { return xs[std::min(xs.size() - 1, static_cast<std::size_t>(next() * xs.size()))]; };
+  const auto pick = [&](std::vector<double> xs) { return xs[std::min(xs.size() - 1, static_cast<std::size_t>(next() * static_cast<double>(xs.size())))]; };
   for (int k = 0; k < 24; ++k) {
     const int n = 3 + static_cast<int>(next() * 5);
     std::vector<BodyDef> bodies;
