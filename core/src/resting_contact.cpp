@@ -44,6 +44,77 @@ Coefficients coefficients(const World& w, std::uint32_t i, const Segment& s) {
   return {m.friction, std::max(m.static_friction, m.friction)};
 }
 
+// The face's law for a rigid block (push_trains, join_train): its total mass M, force
+// along the face F, static friction H and kinetic friction K; members summed in the order
+// along the face, so the sums are the same bits whatever the numbering.
+struct Law {
+  double M = 0.0, F = 0.0, H = 0.0, K = 0.0;
+};
+// Member m's own law under the force acceleration acc.
+Law face_law(const World& w, std::uint32_t m, Vec2 acc) {
+  const Vec2 nn = w.support_n[m], tt = perp(nn);
+  const Coefficients c = coefficients(w, m, w.statics.segments[w.support[m]]);
+  const double mass = 1.0 / w.inv_mass[m];
+  const double N = mass * std::max(-dot(acc, nn), 0.0);
+  return Law{mass, mass * dot(acc, tt), c.holding * N, c.moving * N};
+}
+// A block's acceleration along the face at velocity v: kinetic friction sliding, held
+// from rest iff its static friction can.
+double block_a(const Law& L, double v) {
+  if (v == 0.0) return std::fabs(L.F) <= L.H ? 0.0 : (L.F - std::copysign(L.K, L.F)) / L.M;
+  return (L.F - std::copysign(L.K, v)) / L.M;
+}
+// The push (per mass) giving member m (force acceleration acc) its block's a: sliding,
+// the difference to its own law; at rest and held (a == 0), each member's friction taking
+// its share of the block's force in proportion to what it can hold.
+Vec2 block_push(const World& w, std::uint32_t m, Vec2 acc, const Law& L, double v, double a) {
+  const Vec2 tt = perp(w.support_n[m]);
+  const Law own = face_law(w, m, acc);
+  if (v != 0.0 || a != 0.0) {
+    const double own_a = (own.F - std::copysign(own.K, v != 0.0 ? v : L.F)) / own.M;
+    return (a - own_a) * tt;
+  }
+  const double share = L.H > 0.0 ? L.F * (own.H / L.H) : 0.0;
+  return ((share - own.F) / own.M) * tt;
+}
+// Body m's force acceleration before this step's pushes (push_trains).
+Vec2 raw_acc(const World& w, std::uint32_t m) {
+  return m < w.train_raw_set.size() && w.train_raw_set[m] ? w.train_raw_acc[m] : w.acc[m];
+}
+// Keeps body m's force acceleration before a push (once a step).
+void keep_raw_acc(World& w, std::uint32_t m) {
+  if (w.train_raw_set.size() < w.size()) w.train_raw_set.resize(w.size(), 0), w.train_raw_acc.resize(w.size());
+  if (w.train_raw_set[m]) return;
+  w.train_raw_set[m] = 1;
+  w.train_raw_acc[m] = w.acc[m];
+  w.train_raw_list.push_back(m);
+}
+// Pooling a chain (sorted along the face, all at velocity v) from the rear: a block behind
+// that would accelerate faster along the face than the block in front presses it and
+// joins it (a tie to round-off joins too, so the pair keeps the same bits). raw: the
+// members' laws under their force accelerations before this step's pushes.
+struct Pool {
+  std::size_t b, e;
+  Law L;
+  double a;
+};
+void pool_blocks(const World& w, std::span<const std::uint32_t> chain, double v, bool raw, std::vector<Pool>& pools) {
+  pools.clear();
+  for (std::size_t x = 0; x < chain.size(); ++x) {
+    const Law L = face_law(w, chain[x], raw ? raw_acc(w, chain[x]) : w.acc[chain[x]]);
+    pools.push_back({x, x + 1, L, block_a(L, v)});
+    while (pools.size() > 1) {
+      const Pool& back = pools[pools.size() - 2];
+      const Pool& front = pools.back();
+      if (!(back.a - front.a > -1e-12 * (std::fabs(back.a) + std::fabs(front.a)))) break;
+      Pool joined{back.b, front.e, {back.L.M + front.L.M, back.L.F + front.L.F, back.L.H + front.L.H, back.L.K + front.L.K}, 0.0};
+      joined.a = block_a(joined.L, v);
+      pools.pop_back();
+      pools.back() = joined;
+    }
+  }
+}
+
 }  // namespace
 
 void support_path(World& w, std::uint32_t i) {
@@ -73,6 +144,7 @@ void stop_on_support(World& w, std::uint32_t i) {
     return;
   }
   w.train_stopping.erase(it);
+  keep_raw_acc(w, i);
   w.acc[i] = w.train_stop_acc[i];
   support_path(w, i);
   w.apath[i] = w.train_stop_apath[i];
@@ -1788,6 +1860,8 @@ void push_trains(World& w) {
   thread_local std::vector<char> mixed, in_block;
   thread_local std::vector<TrainPair> pairs;
   w.train_stopping.clear();
+  for (std::uint32_t m : w.train_raw_list) w.train_raw_set[m] = 0;
+  w.train_raw_list.clear();
   train_pairs(w, pairs);
   if (pairs.empty()) return;
   root.resize(n);
@@ -1799,59 +1873,10 @@ void push_trains(World& w) {
     while (root[m] != m) m = root[m] = root[root[m]];
     return m;
   };
-  // The face's law for a rigid block: members (sorted along the face, so the sums are the
-  // same bits whatever the numbering) all move at the block's velocity v (the first
-  // member's: they agree to round-off) and acceleration a.
-  struct Law {
-    double M = 0.0, F = 0.0, H = 0.0, K = 0.0;
-  };
-  const auto law_of = [&](std::uint32_t m) {
-    const Vec2 nn = w.support_n[m], tt = perp(nn);
-    const Coefficients c = coefficients(w, m, w.statics.segments[w.support[m]]);
-    const double mass = 1.0 / w.inv_mass[m];
-    const double N = mass * std::max(-dot(w.acc[m], nn), 0.0);
-    return Law{mass, mass * dot(w.acc[m], tt), c.holding * N, c.moving * N};
-  };
-  const auto block_a = [](const Law& L, double v) {
-    if (v == 0.0) return std::fabs(L.F) <= L.H ? 0.0 : (L.F - std::copysign(L.K, L.F)) / L.M;
-    return (L.F - std::copysign(L.K, v)) / L.M;
-  };
-  // The push (per mass) giving member m the block's a: sliding, the difference to its own
-  // law; at rest and held (a == 0), each member's friction taking its share of the block's
-  // force in proportion to what it can hold.
-  const auto push_for = [&](std::uint32_t m, const Law& L, double v, double a) {
-    const Vec2 tt = perp(w.support_n[m]);
-    const Law own = law_of(m);
-    if (v != 0.0 || a != 0.0) {
-      const double own_a = (own.F - std::copysign(own.K, v != 0.0 ? v : L.F)) / own.M;
-      return (a - own_a) * tt;
-    }
-    const double share = L.H > 0.0 ? L.F * (own.H / L.H) : 0.0;
-    return ((share - own.F) / own.M) * tt;
-  };
-  // Pooling a chain (sorted along the face, all at velocity v) from the rear: a block behind
-  // that would accelerate faster along the face than the block in front presses it and
-  // joins it (a tie to round-off joins too, so the pair keeps the same bits).
-  struct Pool {
-    std::size_t b, e;
-    Law L;
-    double a;
-  };
+  const auto law_of = [&](std::uint32_t m) { return face_law(w, m, w.acc[m]); };
+  const auto push_for = [&](std::uint32_t m, const Law& L, double v, double a) { return block_push(w, m, w.acc[m], L, v, a); };
   const auto pool = [&](std::span<const std::uint32_t> chain, double v, std::vector<Pool>& pools) {
-    pools.clear();
-    for (std::size_t x = 0; x < chain.size(); ++x) {
-      const Law L = law_of(chain[x]);
-      pools.push_back({x, x + 1, L, block_a(L, v)});
-      while (pools.size() > 1) {
-        const Pool& back = pools[pools.size() - 2];
-        const Pool& front = pools.back();
-        if (!(back.a - front.a > -1e-12 * (std::fabs(back.a) + std::fabs(front.a)))) break;
-        Pool joined{back.b, front.e, {back.L.M + front.L.M, back.L.F + front.L.F, back.L.H + front.L.H, back.L.K + front.L.K}, 0.0};
-        joined.a = block_a(joined.L, v);
-        pools.pop_back();
-        pools.back() = joined;
-      }
-    }
+    pool_blocks(w, chain, v, false, pools);
   };
   thread_local std::vector<Pool> rest_pools;
   // Members of a block get its velocity and acceleration to the bit. static_push: at rest and
@@ -1875,6 +1900,7 @@ void push_trains(World& w) {
     for (std::uint32_t m : blk) {
       if (!(v == 0.0 && a == 0.0 && static_push)) push[m] = push_for(m, L, v, a);
       if (blk.size() > 1) in_block[m] = 1;
+      keep_raw_acc(w, m);
       w.acc[m] += push[m];
       push[m] = {};
       w.vel[m] = v * tt;
@@ -1988,6 +2014,7 @@ void push_trains(World& w) {
       if (!gs_pair(p)) continue;
       for (std::uint32_t m : {p.i, p.j}) {
         if (push[m].x == 0.0 && push[m].y == 0.0) continue;
+        keep_raw_acc(w, m);
         w.acc[m] += push[m];
         push[m] = {};
         support_path(w, m);
@@ -2071,6 +2098,111 @@ void apply_supports(World& w, const StepContext& ctx) {
   }
   judge_braced_holds(w);
   if (!w.varying_forces) push_trains(w);
+}
+
+bool join_train(World& w, std::span<const std::uint32_t> chain_in, std::uint32_t i, std::uint32_t j, double t, double vr,
+                std::vector<std::uint32_t>& moved) {
+  moved.clear();
+  if (w.varying_forces || w.any_rules || chain_in.size() < 2) return false;
+  const Vec2 tt = perp(w.support_n[i]);
+  thread_local std::vector<std::uint32_t> chain;
+  thread_local std::vector<double> along, vt;
+  chain.assign(chain_in.begin(), chain_in.end());
+  along.resize(w.size());
+  vt.resize(w.size());
+  for (std::uint32_t m : chain) {
+    along[m] = dot(w.pos_at(m, t), tt);
+    vt[m] = dot(w.vel_at(m, t), tt);
+  }
+  std::sort(chain.begin(), chain.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return along[a] < along[b] || (along[a] == along[b] && a < b);
+  });
+  // The perfectly inelastic impact of the chain: pooled from the rear by momentum (a block
+  // behind moving faster than the block in front meets it; a tie to round-off joins too).
+  struct Moving {
+    std::size_t b, e;
+    double M, P, v;
+  };
+  thread_local std::vector<Moving> blocks;
+  blocks.clear();
+  for (std::size_t x = 0; x < chain.size(); ++x) {
+    const std::uint32_t m = chain[x];
+    const double mass = 1.0 / w.inv_mass[m];
+    blocks.push_back({x, x + 1, mass, mass * vt[m], vt[m]});
+    while (blocks.size() > 1) {
+      const Moving& back = blocks[blocks.size() - 2];
+      const Moving& front = blocks.back();
+      if (!(back.v - front.v > -1e-12 * (std::fabs(back.v) + std::fabs(front.v)))) break;
+      const double M = back.M + front.M, P = back.P + front.P;
+      const Moving joined{back.b, front.e, M, P, P / M};
+      blocks.pop_back();
+      blocks.back() = joined;
+    }
+  }
+  const auto at = [&](std::uint32_t m) {
+    return static_cast<std::size_t>(std::find(chain.begin(), chain.end(), m) - chain.begin());
+  };
+  const std::size_t xi = at(i), xj = at(j);
+  const auto hit = std::find_if(blocks.begin(), blocks.end(), [&](const Moving& q) { return q.b <= xi && xi < q.e; });
+  if (hit == blocks.end() || !(hit->b <= xj && xj < hit->e)) return false;
+  const std::span<const std::uint32_t> blk = std::span<const std::uint32_t>(chain).subspan(hit->b, hit->e - hit->b);
+  double vmin = INFINITY, vmax = -INFINITY;
+  for (std::uint32_t m : blk) vmin = std::min(vmin, vt[m]), vmax = std::max(vmax, vt[m]);
+  const double spread = vmax - vmin;
+  // A slow impact onto a body at rest: its supports absorb it (as resolve_static).
+  const bool slow = std::fabs(vt[i] - vt[j]) < w.collapse_speed(i, j);
+  for (std::uint32_t m : blk) {
+    if (slow && w.stationary(m)) return false;
+  }
+  // No other pair of the block may bounce: none met faster than the spread.
+  for (std::size_t x = 0; x + 1 < blk.size(); ++x) {
+    const std::uint32_t a = blk[x], b = blk[x + 1];
+    if ((a == i && b == j) || (a == j && b == i)) continue;
+    const PairMaterial m = w.pair_material(w.material[a], w.material[b]);
+    const double e = spread < w.collapse_speed(a, b) ? 0.0 : m.restitution;
+    if (!(e * spread < vr)) return false;
+  }
+  const double v = hit->P / hit->M;
+  thread_local std::vector<Pool> pools, rest_pools;
+  pool_blocks(w, blk, v, true, pools);
+  for (std::uint32_t m : blk) {
+    end_substep(w, m, t);
+    std::erase(w.train_stopping, m);
+    moved.push_back(m);
+  }
+  // Each block as push_trains' set_block: its members at its velocity and acceleration to
+  // the bit, the pushes added to their force accelerations, and a block sliding to a stop
+  // its members' paths from rest.
+  const std::size_t n = w.size();
+  for (const Pool& q : pools) {
+    const std::span<const std::uint32_t> mem = blk.subspan(q.b, q.e - q.b);
+    const double a = q.a;
+    for (std::uint32_t m : mem) {
+      keep_raw_acc(w, m);
+      w.acc[m] = w.train_raw_acc[m];
+    }
+    if (mem.size() > 1 && v != 0.0 && a != 0.0 && (a > 0.0) != (v > 0.0)) {
+      if (w.train_stop_acc.size() < n) w.train_stop_acc.resize(n), w.train_stop_apath.resize(n), w.train_block.resize(n);
+      pool_blocks(w, mem, 0.0, true, rest_pools);
+      for (const Pool& r : rest_pools) {
+        for (std::size_t x = r.b; x < r.e; ++x) {
+          const std::uint32_t m = mem[x];
+          w.train_stop_acc[m] = w.acc[m] + block_push(w, m, w.acc[m], r.L, 0.0, r.a);
+          w.train_stop_apath[m] = r.a * tt;
+          w.train_block[m] = mem[0];
+          w.train_stopping.push_back(m);
+        }
+      }
+    }
+    for (std::uint32_t m : mem) {
+      w.acc[m] += block_push(w, m, w.acc[m], q.L, v, a);
+      w.vel[m] = v * tt;
+      support_path(w, m);
+      w.vel[m] = v * tt;
+      w.apath[m] = a * tt;
+    }
+  }
+  return true;
 }
 
 double support_stop_time(const World& w, std::uint32_t i, double t, double T) {
