@@ -5,8 +5,10 @@
 // grids end to end through the physval command.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "physval/adapters/registry.hpp"
 #include "physval/validation/comparator.hpp"
@@ -270,6 +272,52 @@ TEST(Hunt, CoreMeetsTheSlopePairClosedForm) { expect_core_meets("slope_pair_push
 // against one another at one instant until the event cap (`diverged`, 0.24 m off). Fixed:
 // the whole touching chain is joined at once (resting_contact.cpp: join_train).
 TEST(Hunt, CoreMeetsTheCatchRowClosedForm) { expect_core_meets("catch_row.toml"); }
+
+// train_hold_frictionless_leader (hunt4): a ball struck through a touching row at rest on a
+// floor (e 0) whose front ball is frictionless: after the impact all four move at 0.0466 m/s;
+// the three with friction stop within 0.37 mm, the frictionless one slides on for ever. In 10
+// of the 24 body orders core ended with all four at rest (47.6 N s gone) or the front ball 9%
+// slow, `ok`: met pairwise, the 1000 kg ball reached the frictionless one below the collapse
+// speed and the slow impact met it, at rest, as fixed ("its supports absorb it"), though a
+// frictionless face absorbs nothing along it. Open (README, The hunt for wrong greens: the fix
+// tried broke the frictionless piles' numbering independence). Every order of the four bodies
+// must meet the closed form.
+TEST(Hunt, DISABLED_CoreMeetsTheFrictionlessLeaderClosedFormInEveryNumbering) {
+  const EngineFactory* core = reference_engine();
+  ASSERT_NE(core, nullptr);
+  const ScenarioLoad l = load_scenario_file(std::string(PHYSVAL_SOURCE_DIR) +
+                                            "/validation/tests/hunt/train_hold_frictionless_leader.toml");
+  ASSERT_TRUE(l.scene.has_value());
+  Scene scene = *l.scene;
+  ASSERT_EQ(scene.bodies.size(), 4u);
+  std::vector<std::size_t> order{0, 1, 2, 3};
+  const std::vector<BodyDef> listed = scene.bodies;
+  int runs = 0;
+  do {
+    for (std::size_t k = 0; k < order.size(); ++k) scene.bodies[k] = listed[order[k]];
+    const RunRecord r = run_and_compare(scene, *core);
+    const std::string which = "order " + std::to_string(order[0]) + std::to_string(order[1]) +
+                              std::to_string(order[2]) + std::to_string(order[3]);
+    EXPECT_EQ(r.status, RunStatus::Ok) << which << ": " << r.reason;
+    ASSERT_TRUE(r.metrics.at("expectation_failures").has_value()) << which;
+    EXPECT_EQ(*r.metrics.at("expectation_failures"), 0.0) << which;
+    ++runs;
+  } while (std::next_permutation(order.begin(), order.end()));
+  EXPECT_EQ(runs, 24);
+}
+
+// slow_strike_frictionless_at_rest (hunt4, open): the same cause alone: a ball at 0.01 m/s
+// strikes a frictionless ball at rest on the floor, which never moves (0.0167 m short at 2 s, `ok`).
+TEST(Hunt, DISABLED_CoreMeetsTheSlowStrikeOnAFrictionlessBallClosedForm) {
+  expect_core_meets("slow_strike_frictionless_at_rest.toml");
+}
+
+// frictionless_into_row_at_wall (hunt4, open): a frictionless ball strikes (e 0) a ball at
+// rest against a wall; it must stop dead, core sends it back at half the rest speed (the
+// micro-bounce's minimum separation) and, frictionless, it slides away for ever (5 mm at 2 s).
+TEST(Hunt, DISABLED_CoreMeetsTheFrictionlessStrikerIntoARowAtAWallClosedForm) {
+  expect_core_meets("frictionless_into_row_at_wall.toml");
+}
 
 // pyramid_of_three: two balls on a frictionless floor and one on top: they must collapse
 // (every other engine does); core held all three at rest for ever, `ok`. Not yet modelled:
