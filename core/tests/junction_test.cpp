@@ -82,5 +82,52 @@ TEST(CoreJunction, APointSlidesAcrossTheJunctionsOfAFloorDrawnInPieces) {
   EXPECT_EQ(runs, 162);
 }
 
+// A ball (r = 0.25) starting on the floor slides across its junctions at v: on the floor
+// all the way (its centre r above the line), at u = u0 + v T at the end, and no more than a
+// few events a step. Before the fix, at the junction the ball was released from one piece
+// at its end, met the next piece's face and, touching the first piece too, was taken as in
+// a V: the simultaneous law at both (one normal) changed nothing, left it free, and it met
+// the next piece again at the same instant until the event cap (`diverged`, no reference),
+// at 2.9 and 3 m/s with the junction at x = 5 (and 7 pieces on a 0.3 rad slope).
+TEST(CoreJunction, ABallSlidesAcrossTheJunctionsOfAFloorDrawnInPieces) {
+  int runs = 0;
+  for (bool surface : {false, true}) {
+    for (int parts : {2, 3, 7}) {
+      for (double angle : {0.0, 0.3, -0.45}) {
+        for (double v : {0.5, 2.9, 3.0, 7.0}) {
+          for (double u0 : {0.0, -1e-4, 1e-3}) {
+            const Vec2 dir{std::cos(angle), std::sin(angle)};
+            const Vec2 n{-dir.y, dir.x};
+            const double r = 0.25;
+            BodyDef b = circle("b", {u0 * dir.x + r * n.x, u0 * dir.y + r * n.y}, {v * dir.x, v * dir.y}, r, 1.0, 0.0);
+            Sim sim(split_floor(parts, angle, surface, b));
+            const double T = 2.0;
+            const double dt = 1.0 / 60.0;
+            double lowest = r;
+            bool broken = false;
+            while (sim.engine.time() < T - 1e-12) {
+              sim.step(std::min(dt, T - sim.engine.time()));
+              lowest = std::min(lowest, dot(sim.state(0).position, n));
+              broken = broken || !sim.engine.broken_guarantee().empty();
+            }
+            const BodyState end = sim.state(0);
+            const std::string what = std::string(surface ? "surface" : "walls") + " parts " + std::to_string(parts) +
+                                     " angle " + std::to_string(angle) + " v " + std::to_string(v) + " u0 " +
+                                     std::to_string(u0);
+            EXPECT_FALSE(broken) << what << ": " << sim.engine.broken_guarantee();
+            EXPECT_GT(lowest, r - 1e-9) << what;
+            EXPECT_NEAR(dot(end.position, dir), u0 + v * T, 1e-9) << what;
+            EXPECT_NEAR(dot(end.position, n), r, 1e-9) << what;
+            EXPECT_NEAR(dot(end.velocity, dir), v, 1e-9) << what;
+            EXPECT_NEAR(dot(end.velocity, n), 0.0, 1e-9) << what;
+            ++runs;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_EQ(runs, 216);
+}
+
 }  // namespace
 }  // namespace physval::test
