@@ -7,6 +7,8 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <memory>
+#include <optional>
 #include <string>
 
 namespace physval {
@@ -147,13 +149,16 @@ struct VectorSink {
 struct FdSink {
   int fd;
   bool ok = true;
-  std::vector<std::uint8_t> buffer;
+  // Not zeroed (make_unique_for_overwrite): a fresh 256 kB block is mapped on demand,
+  // so a small record touches (and faults in) only the pages it fills.
+  static constexpr std::size_t kSize = std::size_t{1} << 18;
+  std::unique_ptr<std::uint8_t[]> buffer = std::make_unique_for_overwrite<std::uint8_t[]>(kSize);
   std::size_t used = 0;
-  explicit FdSink(int f) : fd(f), buffer(1 << 18) {}
+  explicit FdSink(int f) : fd(f) {}
   void flush() {
     std::size_t done = 0;
     while (ok && done < used) {
-      const ssize_t w = ::write(fd, buffer.data() + done, used - done);
+      const ssize_t w = ::write(fd, buffer.get() + done, used - done);
       if (w < 0) {
         if (errno == EINTR) continue;
         ok = false;
@@ -166,9 +171,9 @@ struct FdSink {
   void put(const void* p, std::size_t n) {
     const auto* c = static_cast<const std::uint8_t*>(p);
     while (n > 0) {
-      if (used == buffer.size()) flush();
-      const std::size_t k = std::min(n, buffer.size() - used);
-      std::memcpy(buffer.data() + used, c, k);
+      if (used == kSize) flush();
+      const std::size_t k = std::min(n, kSize - used);
+      std::memcpy(buffer.get() + used, c, k);
       used += k;
       c += k;
       n -= k;
@@ -191,7 +196,8 @@ struct VectorSource {
 struct FdSource {
   int fd;
   std::optional<std::chrono::steady_clock::time_point> deadline;
-  std::vector<std::uint8_t> buffer = std::vector<std::uint8_t>(1 << 18);
+  static constexpr std::size_t kSize = std::size_t{1} << 18;
+  std::unique_ptr<std::uint8_t[]> buffer = std::make_unique_for_overwrite<std::uint8_t[]>(kSize);   // not zeroed
   std::size_t begin = 0, end = 0, total = 0;
   void fill() {
     for (;;) {
@@ -205,7 +211,7 @@ struct FdSource {
       const int ready = ::poll(&p, 1, wait_ms);
       if (ready < 0 && errno == EINTR) continue;
       if (ready == 0) continue;   // re-checks the deadline
-      const ssize_t got = ::read(fd, buffer.data(), buffer.size());
+      const ssize_t got = ::read(fd, buffer.get(), kSize);
       if (got < 0 && errno == EINTR) continue;
       if (got <= 0) throw std::runtime_error("run record: the stream ended early");
       begin = 0;
@@ -219,7 +225,7 @@ struct FdSource {
     while (n > 0) {
       if (begin == end) fill();
       const std::size_t k = std::min(n, end - begin);
-      std::memcpy(c, buffer.data() + begin, k);
+      std::memcpy(c, buffer.get() + begin, k);
       begin += k;
       c += k;
       n -= k;
