@@ -386,11 +386,17 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
       // when both steps were straight (neither body met anything in it), each bend added.
       // A point (radius 0) has passed into a circle when it gets half-way to its centre.
       const double smaller = std::min(ri, rj) > 0.0 ? std::min(ri, rj) : 0.5 * std::max(ri, rj);
+      // Of two circles of unequal size, the small one has gone into the large one when it
+      // is wholly inside it (centres closer than the difference of the radii: an overlap
+      // deeper than the small one's diameter): a 1 cm ball at 10-300 m/s went 0.5 m deep
+      // into a resting 1 m ball, or right through it off its centre, on Box2D, Bullet,
+      // Chipmunk and ODE, never within 1 cm of its centre, and every run was `ok`.
+      const double into = std::min(ri, rj) > 0.0 ? std::max(smaller, std::max(ri, rj) - smaller) : smaller;
       // The bends (six square roots) are worked out only when they can decide: the path's
       // closest approach plus a bend (>= 0) is never below the approach alone, so when the
       // centres are inside now, or the path never comes inside, the answer is the same.
       double closest = ri + rj - depth;
-      const double inside = smaller - eps_;
+      const double inside = into - eps_;
       if (!(closest < inside)) {
         const Vec2 d0 = before(i) - before(j), dd = (xi - xj) - d0;
         const double len2 = dot(dd, dd);
