@@ -130,4 +130,30 @@ final = [ { body = "shell", velocity = [1.0, 0.0], position = [0.5, 0.0] } ]
   }
 }
 
+// A static body given a velocity (a "moving post") stood still on every engine, and the
+// scene ran `ok`: the key said something no run did. It is bad input now, as is a thrust
+// table on a static body.
+TEST_F(VacuousChecks, AStaticBodyWithAVelocityOrThrustIsBadInput) {
+  const std::string post = R"(name = "post"
+duration = 1.0
+[[bodies]]
+name = "post"
+radius = 0.5
+static = true
+position = [0.0, 0.0]
+)";
+  const fs::path moving = write("moving.toml", post + "velocity = [1.0, 0.0]\n");
+  Result r = physval("check " + moving.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find(moving.string() + ":8:12: bodies[0].velocity: a static body does not move"), std::string::npos)
+      << r.output;
+  const fs::path pushed = write("pushed.toml", post + "[bodies.thrust]\nspeeds = [0.0]\naccel = [1.0]\n");
+  r = physval("check " + pushed.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("bodies[0].thrust: a static body does not move"), std::string::npos) << r.output;
+  const fs::path still = write("still.toml", post + "velocity = [0.0, 0.0]\n");
+  r = physval("check " + still.string());
+  EXPECT_EQ(r.status, 0) << r.output;
+}
+
 }  // namespace
