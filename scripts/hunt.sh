@@ -21,6 +21,7 @@
 #   kink      concave and convex kinks of a track (two walls or a surface): core to 1e-7
 #   inclinebounce, pointsettle   a bounce with friction on a slope, a point bouncing to rest
 #   train     two balls sliding as one train (or apart) to a stop on a floor: core to 1e-8
+#   catch     a ball catching another (or two touching ones) down a slope, then one block: core to 1e-8
 #   draglin, dragquad, thrust, dragwall   the converged reference must meet the closed form
 #   every closed-form run: an engine's position_divergence must see its miss
 #   box       a point or a ball at 5-5000 m/s in a box of walls (0.3-20 m), axis, 17 deg and
@@ -605,6 +606,109 @@ friction = 0.0
 """, [xb, 0.5], [vb, 0.0], 1e-8)
                 truth[n]["front"] = {"position": [xf, 0.5], "velocity": [vf, 0.0]}
 
+# catch: on a 10-40 degree slope, a ball of friction mu_b starts 0.3 m behind one of mu_f >
+# mu_b, both at rest: it catches up at sqrt(2 gap / (a_b - a_f)), the e = 0 impact shares
+# their momentum, and they slide on as one block at g (sin - cos (m_b mu_b + m_f mu_f) / M).
+for deg in [10, 25, 40]:
+    for mub, muf in [(0.0, 0.1), (0.05, 0.3), (0.1, 0.2)]:
+        for mb, mf in [(1.0, 1.0), (4.0, 1.0), (1.0, 4.0)]:
+            for order in [0, 1]:
+                th = math.radians(deg)
+                t, nn = (math.cos(th), -math.sin(th)), (math.sin(th), math.cos(th))
+                ab, af = g * (math.sin(th) - mub * math.cos(th)), g * (math.sin(th) - muf * math.cos(th))
+                if af <= 0:
+                    continue
+                t1 = math.sqrt(2 * 0.3 / (ab - af))
+                v = (mb * ab + mf * af) * t1 / (mb + mf)
+                a = g * math.sin(th) - g * math.cos(th) * (mb * mub + mf * muf) / (mb + mf)
+                sf = 0.5 * af * t1 * t1 + v * 0.5 + 0.5 * a * 0.25
+                at = lambda x: [x * t[0] + 0.5 * nn[0], x * t[1] + 0.5 * nn[1]]
+                bodies = [("back", -1.3, mb), ("front", 0.0, mf)][::(-1 if order else 1)]
+                txt = "".join(f"""[[bodies]]
+name = "{nm}"
+radius = 0.5
+mass = {m}
+position = [{at(x)[0]!r}, {at(x)[1]!r}]
+restitution = 0.0
+""" for nm, x, m in bodies)
+                n = f"catch_{deg}_{mub}_{muf}_{mb}_{mf}_{order}".replace(".", "p")
+                exact(n, f"""name = "{n}"
+duration = {t1 + 0.5!r}
+[world]
+gravity = [0.0, -{g}]
+{txt}[[walls]]
+name = "slope"
+from = [{-10 * t[0]!r}, {-10 * t[1]!r}]
+to = [{60 * t[0]!r}, {60 * t[1]!r}]
+restitution = 0.0
+friction = 1.0
+[[materials]]
+a = "back"
+b = "slope"
+friction = {mub}
+[[materials]]
+a = "front"
+b = "slope"
+friction = {muf}
+[[materials]]
+a = "back"
+b = "front"
+friction = 0.0
+""", at(sf - 1.0), [(v + 0.5 * a) * t[0], (v + 0.5 * a) * t[1]], 1e-8)
+                truth[n]["front"] = {"position": at(sf), "velocity": [(v + 0.5 * a) * t[0], (v + 0.5 * a) * t[1]]}
+
+# catch (a row): the same with a ball catching two touching balls (frictions mu_m <= mu_f,
+# sliding from rest as one block at g (sin - cos (m_m mu_m + m_f mu_f) / (m_m + m_f))):
+# the impact shares the three momenta at once, then one block of all three.
+for deg in [10, 25, 40]:
+    for mub, mum, muf in [(0.0, 0.1, 0.1), (0.05, 0.2, 0.3), (0.1, 0.15, 0.2)]:
+        for mb, mm, mf in [(1.0, 1.0, 1.0), (4.0, 1.0, 1.0), (1.0, 4.0, 1.0), (1.0, 1.0, 4.0)]:
+            for order in [0, 1]:
+                th = math.radians(deg)
+                t, nn = (math.cos(th), -math.sin(th)), (math.sin(th), math.cos(th))
+                ab = g * (math.sin(th) - mub * math.cos(th))
+                at_ = g * (math.sin(th) - math.cos(th) * (mm * mum + mf * muf) / (mm + mf))
+                if at_ <= 0:
+                    continue
+                t1 = math.sqrt(2 * 0.3 / (ab - at_))
+                M = mb + mm + mf
+                v = (mb * ab + (mm + mf) * at_) * t1 / M
+                a = g * math.sin(th) - g * math.cos(th) * (mb * mub + mm * mum + mf * muf) / M
+                sm = 0.5 * at_ * t1 * t1 + v * 0.5 + 0.5 * a * 0.25
+                at = lambda x: [x * t[0] + 0.5 * nn[0], x * t[1] + 0.5 * nn[1]]
+                bodies = [("back", -1.3, mb, mub), ("mid", 0.0, mm, mum), ("front", 1.0, mf, muf)][::(-1 if order else 1)]
+                txt = "".join(f"""[[bodies]]
+name = "{nm}"
+radius = 0.5
+mass = {m}
+position = [{at(x)[0]!r}, {at(x)[1]!r}]
+restitution = 0.0
+""" for nm, x, m, _ in bodies)
+                mats = "".join(f"""[[materials]]
+a = "{nm}"
+b = "slope"
+friction = {mu}
+""" for nm, _, _, mu in bodies) + "".join(f"""[[materials]]
+a = "{x}"
+b = "{y}"
+friction = 0.0
+""" for x, y in [("back", "mid"), ("back", "front"), ("mid", "front")])
+                n = f"catch_row_{deg}_{mub}_{mum}_{muf}_{mb}_{mm}_{mf}_{order}".replace(".", "p")
+                u = [(v + 0.5 * a) * t[0], (v + 0.5 * a) * t[1]]
+                exact(n, f"""name = "{n}"
+duration = {t1 + 0.5!r}
+[world]
+gravity = [0.0, -{g}]
+{txt}[[walls]]
+name = "slope"
+from = [{-10 * t[0]!r}, {-10 * t[1]!r}]
+to = [{60 * t[0]!r}, {60 * t[1]!r}]
+restitution = 0.0
+friction = 1.0
+{mats}""", at(sm - 1.0), u, 1e-8)
+                truth[n]["mid"] = {"position": at(sm), "velocity": u}
+                truth[n]["front"] = {"position": at(sm + 1.0), "velocity": u}
+
 # box: a point or a 5 cm ball at 5-5000 m/s in a box of four walls (half-width 0.3-20 m),
 # e = 1, with and without gravity, along an axis, at 17 degrees, and into the corners.
 for v in [5, 50, 200, 1000, 5000]:
@@ -809,7 +913,7 @@ for r in runs:
     t = truth.get(sc)
     if t is None or r["status"] in ("unsupported", "error"):
         continue
-    first = "back" if sc.startswith("train_") else "b"
+    first = "back" if sc.startswith(("train_", "catch_")) else "b"
     f = [b for b in r["final"] if b["body"] == first][0]
     err = max(math.dist(f["position"], t["position"]), math.dist(f["velocity"], t["velocity"]))
     for b in r["final"]:

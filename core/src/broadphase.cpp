@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <numeric>
 #include <stdexcept>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "broadphase_common.hpp"
 
@@ -79,9 +82,21 @@ class AllPairsBroadPhase final : public bp_detail::BroadPhaseBase {
   }
 
   void query_box(const Aabb& a, std::uint32_t exclude, std::vector<std::uint32_t>& out) override {
+#if defined(__SSE2__)
+    // overlaps() as one four-lane comparison: b.min <= a.max and -b.max <= -a.min (negation
+    // is exact and keeps a NaN a NaN, which compares false either way).
+    static_assert(sizeof(Aabb) == 4 * sizeof(float));
+    const __m128 flip = _mm_castsi128_ps(_mm_set_epi32(INT32_MIN, INT32_MIN, 0, 0));
+    const __m128 q = _mm_set_ps(-a.min_y, -a.min_x, a.max_y, a.max_x);
+    for (const std::uint32_t j : list_) {
+      const __m128 b = _mm_xor_ps(_mm_loadu_ps(&boxes_[j].min_x), flip);
+      if (_mm_movemask_ps(_mm_cmple_ps(b, q)) == 0xF && j != exclude) out.push_back(j);
+    }
+#else
     for (std::uint32_t j : list_) {
       if (j != exclude && overlaps(a, boxes_[j])) out.push_back(j);
     }
+#endif
   }
 
   void grow(std::uint32_t i, const Aabb& b) override {

@@ -546,6 +546,60 @@ class EventLoop {
     return hold(i);
   }
 
+  // i and j, on faces of one normal and touching along it, met slowly and pressed together
+  // at t: with every body touching them along the face (transitively), if none of those
+  // touches anything else, joined as one train (join_train); the others' new paths
+  // scheduled here (i's and j's by the caller).
+  bool join_chain(std::uint32_t i, std::uint32_t j, Vec2 n, double t, double vr) {
+    if (w_.varying_forces || w_.any_rules) return false;
+    const Vec2 nn = w_.support_n[i];
+    const auto on_line = [&](std::uint32_t x) {
+      return w_.alive(x) && w_.dynamic(x) && (w_.flags[x] & (kParticle | kPoint)) == 0 && w_.supported(x) &&
+             !w_.on_body(x) && !w_.is_held(x) && w_.support_n[x] == nn;
+    };
+    if (!on_line(i) || !on_line(j) || std::fabs(dot(n, nn)) > 1e-9) return false;
+    chain_.clear();
+    chain_.push_back(i);
+    chain_.push_back(j);
+    for (std::size_t q = 0; q < chain_.size(); ++q) {
+      const std::uint32_t m = chain_[q];
+      const Vec2 p = w_.pos_at(m, t);
+      const double r = w_.radius[m];
+      const double pad = r + 1e-9 * (r + w_.length_scale);
+      // Every face it touches but its own ends the chain's case (a wall, a step).
+      w_.found_static.clear();
+      w_.statics.query(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), w_.found_static);
+      for (std::uint32_t k : w_.found_static) {
+        if (k == w_.support[m]) continue;
+        const Segment& s = w_.statics.segments[k];
+        const double u = std::clamp(dot(p - s.from, s.dir), 0.0, s.length);
+        if (length(p - (s.from + u * s.dir)) <= pad) return false;
+      }
+      near_.clear();
+      // (a body touching it meets its box, and so does that body's registered box)
+      w_.bp->query_box(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), m, near_);
+      for (std::uint32_t k : near_) {
+        if (std::find(chain_.begin(), chain_.end(), k) != chain_.end()) continue;
+        const Vec2 d = w_.pos_at(k, t) - p;
+        const double dist = length(d);
+        const double R = r + w_.radius[k];
+        const double tol = 1e-9 * (R + w_.length_scale);
+        if (dist - R > tol) continue;   // apart
+        // Touching: on the line, along the face, not overlapping; else not a train's case.
+        if (!on_line(k) || !(dist > 0.0) || R - dist > tol || std::fabs(dot(d / dist, nn)) > 1e-9) return false;
+        if (chain_.size() >= kMaxChain) return false;
+        chain_.push_back(k);
+      }
+    }
+    if (!join_train(w_, chain_, i, j, t, vr, moved_)) return false;
+    for (std::uint32_t m : moved_) {
+      if (m == i || m == j) continue;
+      ++w_.version[m];
+      reschedule(m, t);
+    }
+    return true;
+  }
+
   void destroy_after(std::uint32_t i, bool by_rule) {
     if (by_rule || (w_.flags[i] & kDestroyOnHit)) kill_body(w_, i);
   }
@@ -643,6 +697,8 @@ class EventLoop {
             settled = true;   // at rest on several supports
           } else if (hold_pocket(i) || hold_pocket(j)) {
             settled = true;   // a group micro-bouncing on its supports: its pocket
+          } else if (join_chain(i, j, n, t, vr)) {
+            settled = true;   // bodies on a face pressed together: one train, joined whole
           } else {
             min_sep = 0.5 * vr;
           }
@@ -916,6 +972,8 @@ class EventLoop {
   std::vector<BodyPair> impacted_;      // its pairs that took an impulse
   std::vector<std::uint32_t> near_;     // bodies near one being held
   std::vector<std::uint32_t> group_;    // a group held at once
+  std::vector<std::uint32_t> chain_, moved_;   // a train joined at an impact (join_chain)
+  static constexpr std::size_t kMaxChain = 64;
   static constexpr std::uint32_t kCycle = 64;
   double instant_ = -1.0;                      // the time of the last pair impact
   std::vector<std::uint32_t> same_instant_;    // per body: its impacts at that time

@@ -23,6 +23,8 @@
 #include <cmath>
 #include <numbers>
 #include <span>
+#include <tuple>
+#include <vector>
 
 #include "physval/core/time_of_impact.hpp"
 #include "world.hpp"
@@ -40,6 +42,77 @@ Coefficients coefficients(const World& w, std::uint32_t i, const Segment& s) {
   const PairMaterial m = w.pair_material(w.material[i], s.material);
   if (m.rolling_friction > 0.0) return {m.rolling_friction, m.rolling_friction};
   return {m.friction, std::max(m.static_friction, m.friction)};
+}
+
+// The face's law for a rigid block (push_trains, join_train): its total mass M, force
+// along the face F, static friction H and kinetic friction K; members summed in the order
+// along the face, so the sums are the same bits whatever the numbering.
+struct Law {
+  double M = 0.0, F = 0.0, H = 0.0, K = 0.0;
+};
+// Member m's own law under the force acceleration acc.
+Law face_law(const World& w, std::uint32_t m, Vec2 acc) {
+  const Vec2 nn = w.support_n[m], tt = perp(nn);
+  const Coefficients c = coefficients(w, m, w.statics.segments[w.support[m]]);
+  const double mass = 1.0 / w.inv_mass[m];
+  const double N = mass * std::max(-dot(acc, nn), 0.0);
+  return Law{mass, mass * dot(acc, tt), c.holding * N, c.moving * N};
+}
+// A block's acceleration along the face at velocity v: kinetic friction sliding, held
+// from rest iff its static friction can.
+double block_a(const Law& L, double v) {
+  if (v == 0.0) return std::fabs(L.F) <= L.H ? 0.0 : (L.F - std::copysign(L.K, L.F)) / L.M;
+  return (L.F - std::copysign(L.K, v)) / L.M;
+}
+// The push (per mass) giving member m (force acceleration acc) its block's a: sliding,
+// the difference to its own law; at rest and held (a == 0), each member's friction taking
+// its share of the block's force in proportion to what it can hold.
+Vec2 block_push(const World& w, std::uint32_t m, Vec2 acc, const Law& L, double v, double a) {
+  const Vec2 tt = perp(w.support_n[m]);
+  const Law own = face_law(w, m, acc);
+  if (v != 0.0 || a != 0.0) {
+    const double own_a = (own.F - std::copysign(own.K, v != 0.0 ? v : L.F)) / own.M;
+    return (a - own_a) * tt;
+  }
+  const double share = L.H > 0.0 ? L.F * (own.H / L.H) : 0.0;
+  return ((share - own.F) / own.M) * tt;
+}
+// Body m's force acceleration before this step's pushes (push_trains).
+Vec2 raw_acc(const World& w, std::uint32_t m) {
+  return m < w.train_raw_set.size() && w.train_raw_set[m] ? w.train_raw_acc[m] : w.acc[m];
+}
+// Keeps body m's force acceleration before a push (once a step).
+void keep_raw_acc(World& w, std::uint32_t m) {
+  if (w.train_raw_set.size() < w.size()) w.train_raw_set.resize(w.size(), 0), w.train_raw_acc.resize(w.size());
+  if (w.train_raw_set[m]) return;
+  w.train_raw_set[m] = 1;
+  w.train_raw_acc[m] = w.acc[m];
+  w.train_raw_list.push_back(m);
+}
+// Pooling a chain (sorted along the face, all at velocity v) from the rear: a block behind
+// that would accelerate faster along the face than the block in front presses it and
+// joins it (a tie to round-off joins too, so the pair keeps the same bits). raw: the
+// members' laws under their force accelerations before this step's pushes.
+struct Pool {
+  std::size_t b, e;
+  Law L;
+  double a;
+};
+void pool_blocks(const World& w, std::span<const std::uint32_t> chain, double v, bool raw, std::vector<Pool>& pools) {
+  pools.clear();
+  for (std::size_t x = 0; x < chain.size(); ++x) {
+    const Law L = face_law(w, chain[x], raw ? raw_acc(w, chain[x]) : w.acc[chain[x]]);
+    pools.push_back({x, x + 1, L, block_a(L, v)});
+    while (pools.size() > 1) {
+      const Pool& back = pools[pools.size() - 2];
+      const Pool& front = pools.back();
+      if (!(back.a - front.a > -1e-12 * (std::fabs(back.a) + std::fabs(front.a)))) break;
+      Pool joined{back.b, front.e, {back.L.M + front.L.M, back.L.F + front.L.F, back.L.H + front.L.H, back.L.K + front.L.K}, 0.0};
+      joined.a = block_a(joined.L, v);
+      pools.pop_back();
+      pools.back() = joined;
+    }
+  }
 }
 
 }  // namespace
@@ -71,6 +144,7 @@ void stop_on_support(World& w, std::uint32_t i) {
     return;
   }
   w.train_stopping.erase(it);
+  keep_raw_acc(w, i);
   w.acc[i] = w.train_stop_acc[i];
   support_path(w, i);
   w.apath[i] = w.train_stop_apath[i];
@@ -607,6 +681,14 @@ bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_
   return true;
 }
 
+// Body j slides on a frictionless face (a face support, not stuck): nothing but a hold
+// ever stops it, so a group's hold (and its pocket) takes it as a member.
+bool frictionless_slider(const World& w, std::uint32_t j) {
+  if (!w.supported(j) || w.on_body(j) || w.is_held(j) || w.stationary(j)) return false;
+  const PairMaterial m = w.pair_material(w.material[j], w.statics.segments[w.support[j]].material);
+  return m.friction == 0.0 && m.static_friction == 0.0;
+}
+
 bool try_hold_group(World& w, std::uint32_t seed, double t, double dt, const NearFn& near_fn,
                     std::vector<std::uint32_t>& members) {
   members.clear();
@@ -628,7 +710,9 @@ bool try_hold_group(World& w, std::uint32_t seed, double t, double dt, const Nea
     near_fn(pos[q], r + 1e-9 * (r + w.length_scale), buf);
     for (std::uint32_t j : buf) {
       if (j == m || !w.dynamic(j) || w.stationary(j)) continue;
-      if (w.supported(j) && !w.on_body(j)) continue;   // on a face: its own path
+      // On a face: its own path, unless it slides slowly on a frictionless face (nothing else
+      // ever stops it there: the group's hold is the limit of its collapse).
+      if (w.supported(j) && !w.on_body(j) && !(slow(j) && frictionless_slider(w, j))) continue;
       if ((w.flags[m] & kPoint) && (w.flags[j] & kPoint)) continue;
       if (((w.flags[m] | w.flags[j]) & kParticle) && related_bodies(w, m, j)) continue;
       if (w.any_rules && !w.response(w.group[m], w.group[j]).collide) continue;
@@ -772,7 +856,7 @@ bool try_hold_group_pocket(World& w, std::uint32_t seed, double t, double dt, co
       if (!pair_ok(m, j) || w.stationary(j)) continue;
       if (std::find(members.begin(), members.end(), j) != members.end()) continue;
       if (length(w.pos_at(j, t) - w.pos_at(m, t)) - (w.radius[m] + w.radius[j]) > reach) continue;
-      if (!w.dynamic(j) || w.supported(j) || !slow(j)) return false;
+      if (!w.dynamic(j) || (w.supported(j) && !frictionless_slider(w, j)) || !slow(j)) return false;
       members.push_back(j);
       if (members.size() > kMaxMembers) return false;
     }
@@ -983,6 +1067,138 @@ bool resting_component(World& w, const BodiesByX& bx, std::uint32_t seed, std::v
   return true;
 }
 
+// The least-squares contact forces of a component exactly: forces x >= 0 on its C columns
+// (column k: a force along d on member b, minus it on member a; a < 0: a fixed support)
+// minimising sum_q m_q |a_q|^2, a_q a member's force acceleration plus its forces over its
+// mass, i.e. min |B x - y| in mass-weighted form (B's rows sqrt(1/m) d, y = -sqrt(m) a).
+// Lawson and Hanson's active-set method; each unconstrained solve on the active columns by
+// Householder QR. False if it does not finish (3 C + 30 additions) or an active set is
+// singular.
+template <class ColFn>
+bool exact_least_squares(const World& w, std::span<const std::uint32_t> members, std::size_t C, ColFn col,
+                         std::vector<double>& x) {
+  const std::size_t M = members.size(), R = 2 * M;
+  std::vector<double> B(R * C, 0.0), y(R), z(C), wv(C), res(R);
+  const auto at = [&](std::size_t row, std::size_t k) -> double& { return B[k * R + row]; };
+  for (std::size_t k = 0; k < C; ++k) {
+    const auto [a, b, d] = col(k);
+    const double sb = std::sqrt(w.inv_mass[members[static_cast<std::size_t>(b)]]);
+    at(2 * static_cast<std::size_t>(b), k) += sb * d.x;
+    at(2 * static_cast<std::size_t>(b) + 1, k) += sb * d.y;
+    if (a >= 0) {
+      const double sa = std::sqrt(w.inv_mass[members[static_cast<std::size_t>(a)]]);
+      at(2 * static_cast<std::size_t>(a), k) -= sa * d.x;
+      at(2 * static_cast<std::size_t>(a) + 1, k) -= sa * d.y;
+    }
+  }
+  double ynorm = 0.0;
+  for (std::size_t q = 0; q < M; ++q) {
+    const double s = -1.0 / std::sqrt(w.inv_mass[members[q]]);
+    y[2 * q] = s * w.acc[members[q]].x;
+    y[2 * q + 1] = s * w.acc[members[q]].y;
+    ynorm = std::max({ynorm, std::fabs(y[2 * q]), std::fabs(y[2 * q + 1])});
+  }
+  x.assign(C, 0.0);
+  std::vector<char> active(C, 0);
+  std::vector<std::size_t> P;
+  std::vector<double> Q, rhs;
+  // z = the least-squares solution on the active columns (0 elsewhere); false if singular.
+  const auto solve = [&]() {
+    const std::size_t n = P.size();
+    Q.assign(R * n, 0.0);
+    for (std::size_t j = 0; j < n; ++j) {
+      for (std::size_t i = 0; i < R; ++i) Q[j * R + i] = at(i, P[j]);
+    }
+    rhs = y;
+    double scale = 0.0;
+    for (double v : Q) scale = std::max(scale, std::fabs(v));
+    for (std::size_t j = 0; j < n; ++j) {   // Householder on column j, rows j..R-1
+      if (j >= R) return false;
+      double norm = 0.0;
+      for (std::size_t i = j; i < R; ++i) norm += Q[j * R + i] * Q[j * R + i];
+      norm = std::sqrt(norm);
+      if (!(norm > 1e-13 * scale)) return false;
+      const double alpha = Q[j * R + j] > 0.0 ? -norm : norm;
+      std::vector<double> v(R - j);
+      for (std::size_t i = j; i < R; ++i) v[i - j] = Q[j * R + i];
+      v[0] -= alpha;
+      double vv = 0.0;
+      for (double e : v) vv += e * e;
+      if (!(vv > 0.0)) continue;
+      for (std::size_t jj = j; jj < n; ++jj) {
+        double s = 0.0;
+        for (std::size_t i = j; i < R; ++i) s += v[i - j] * Q[jj * R + i];
+        s *= 2.0 / vv;
+        for (std::size_t i = j; i < R; ++i) Q[jj * R + i] -= s * v[i - j];
+      }
+      double s = 0.0;
+      for (std::size_t i = j; i < R; ++i) s += v[i - j] * rhs[i];
+      s *= 2.0 / vv;
+      for (std::size_t i = j; i < R; ++i) rhs[i] -= s * v[i - j];
+    }
+    std::fill(z.begin(), z.end(), 0.0);
+    for (std::size_t j = n; j-- > 0;) {
+      double s = rhs[j];
+      for (std::size_t jj = j + 1; jj < n; ++jj) s -= Q[jj * R + j] * z[P[jj]];
+      z[P[j]] = s / Q[j * R + j];
+    }
+    return true;
+  };
+  const auto gradient = [&]() {   // wv = B^T (y - B x)
+    res = y;
+    for (std::size_t k = 0; k < C; ++k) {
+      if (x[k] == 0.0) continue;
+      for (std::size_t i = 0; i < R; ++i) res[i] -= at(i, k) * x[k];
+    }
+    for (std::size_t k = 0; k < C; ++k) {
+      double s = 0.0;
+      for (std::size_t i = 0; i < R; ++i) s += at(i, k) * res[i];
+      wv[k] = s;
+    }
+  };
+  gradient();
+  for (std::size_t outer = 0; outer < 3 * C + 30; ++outer) {
+    std::size_t t = C;
+    double best = 1e-13 * ynorm;
+    for (std::size_t k = 0; k < C; ++k) {
+      if (!active[k] && wv[k] > best) {
+        best = wv[k];
+        t = k;
+      }
+    }
+    if (t == C) return true;   // no column would lower the residual: optimal
+    active[t] = 1;
+    P.push_back(t);
+    for (int inner = 0;; ++inner) {
+      if (inner > static_cast<int>(C) + 10 || !solve()) return false;
+      bool positive = true;
+      for (std::size_t k : P) positive = positive && z[k] > 0.0;
+      if (positive) {
+        for (std::size_t k : P) x[k] = z[k];
+        break;
+      }
+      double alpha = 1.0;
+      for (std::size_t k : P) {
+        if (z[k] <= 0.0) alpha = std::min(alpha, x[k] / (x[k] - z[k]));
+      }
+      for (std::size_t k : P) x[k] += alpha * (z[k] - x[k]);
+      std::vector<std::size_t> keep;
+      for (std::size_t k : P) {
+        if (x[k] > 0.0) {
+          keep.push_back(k);
+        } else {
+          x[k] = 0.0;
+          active[k] = 0;
+        }
+      }
+      P = keep;
+      if (P.empty()) break;
+    }
+    gradient();
+  }
+  return false;
+}
+
 // Whether a resting component (sorted members; faces and static bodies fixed) can be held
 // by rigid Coulomb contact: a normal force >= 0 at every contact and a static friction
 // force within mu times it, every member's acceleration zero. The tolerances of
@@ -991,6 +1207,7 @@ bool resting_component(World& w, const BodiesByX& bx, std::uint32_t seed, std::v
 // member taken as fixed. kCannotHold only with a certificate (below), else kUndecided.
 // `residual`: the largest acceleration left on a member by Gauss-Seidel.
 enum class Verdict { kHeld, kCannotHold, kUndecided };
+constexpr std::size_t kMaxExact = 256;   // columns and members an exact solve takes on
 
 Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint32_t> members, double& residual) {
   thread_local std::vector<std::pair<std::uint32_t, Vec2>> touch;
@@ -1006,6 +1223,7 @@ Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint
     std::int32_t a, b;   // member indices; a = -1: a fixed support
     Vec2 d;              // the force on b per unit (on a: minus it)
     double height;       // of the contact, along the members' mean force (for the order)
+    bool edge;           // a friction cone's edge (else a frictionless contact's normal)
   };
   thread_local std::vector<Col> cols;
   cols.clear();
@@ -1014,10 +1232,10 @@ Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint
   const auto add = [&](std::int32_t a, std::int32_t b, Vec2 nrm, double m, Vec2 at) {
     const double h = -dot(at, down);
     if (m > 0.0) {
-      cols.push_back({a, b, nrm + m * perp(nrm), h});
-      cols.push_back({a, b, nrm - m * perp(nrm), h});
+      cols.push_back({a, b, nrm + m * perp(nrm), h, true});
+      cols.push_back({a, b, nrm - m * perp(nrm), h, true});
     } else {
-      cols.push_back({a, b, nrm, h});
+      cols.push_back({a, b, nrm, h, false});
     }
   };
   for (std::size_t q = 0; q < M; ++q) {
@@ -1177,15 +1395,85 @@ Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint
   // force acceleration) while the forces do positive work along them (they are the least
   // mass-weighted residual, so their work is its square): a motion the contacts allow and
   // the forces drive. Else Gauss-Seidel has not converged and nothing is certain.
-  double worst = INFINITY;
+  //
+  // The certificate is a motion: the members' accelerations under the least-squares forces,
+  // which for frictionless contacts are rigid contact's own (Gauss's principle: a force >= 0
+  // only where the pair's normal acceleration is 0, and >= 0 everywhere). It shows a hold
+  // wrong only if it moves a body core keeps at rest (held, or stuck on its supports). If it
+  // moves only members core lets move (a slow free body, or one sliding on a face, taken in
+  // as it may be micro-bouncing on the others), and every force on a moving member is a
+  // frictionless normal force (a cone edge's force is static friction's only between bodies
+  // at rest), the forces are a rigid Coulomb solution in which every body core keeps at rest
+  // is at rest: the holds are justified. (A ball falling past a held stack, touching its side
+  // within 1e-9 on the way, was reported as the stack's hold failing: 9.8 m/s^2 left on the
+  // falling ball, none on the stack.)
+  // `exact`: forces from an exact least-squares solve (below), accurate to the round-off of
+  // its largest forces (Householder QR is backward stable): a relative acceleration along an
+  // edge >= -64 eps x the largest force acceleration on a member counts as >= 0 there. (A
+  // member is at rest within the round-off of its own forces, as above: stricter.)
+  const auto verdict_of = [&](std::span<const Vec2> a, std::span<const double> l, bool exact) {
+    force_sum.assign(M, 0.0);
+    for (std::size_t k = 0; k < C; ++k) {
+      const double f = std::fabs(l[k]) * length(cols[k].d);
+      if (cols[k].a >= 0) force_sum[static_cast<std::size_t>(cols[k].a)] += f * inv(cols[k].a);
+      force_sum[static_cast<std::size_t>(cols[k].b)] += f * inv(cols[k].b);
+    }
+    const auto slack = [&](std::int32_t x) { return x < 0 ? 0.0 : 64.0 * 2.220446049250313e-16 * force_sum[static_cast<std::size_t>(x)]; };
+    const auto rel = [&](const Col& c) {
+      const Vec2 aa = c.a < 0 ? Vec2{} : a[static_cast<std::size_t>(c.a)];
+      return dot(a[static_cast<std::size_t>(c.b)] - aa, c.d) / length(c.d);
+    };
+    double solve_slack = 0.0;   // an exact solve's round-off: that of its largest forces
+    for (std::size_t q = 0; q < M; ++q) solve_slack = std::max(solve_slack, slack(static_cast<std::int32_t>(q)));
+    double work = 0.0;
+    for (std::size_t q = 0; q < M; ++q) work += dot(w.acc[members[q]], a[q]) / inv(static_cast<std::int32_t>(q));
+    if (!(work > 0.0)) return Verdict::kUndecided;
+    for (const Col& c : cols) {
+      if (!(rel(c) >= -1e-12 * amax - (exact ? solve_slack : 0.0))) return Verdict::kUndecided;
+    }
+    const auto moves = [&](std::int32_t q) {   // the certificate moves member q
+      if (q < 0) return false;
+      const auto u = static_cast<std::size_t>(q);
+      return length(a[u]) > 1e-9 * length(w.acc[members[u]]) + slack(q);
+    };
+    for (std::size_t q = 0; q < M; ++q) {
+      const std::uint32_t m = members[q];
+      if (moves(static_cast<std::int32_t>(q)) && (w.is_held(m) || w.stationary(m))) return Verdict::kCannotHold;
+    }
+    for (std::size_t k = 0; k < C; ++k) {
+      const Col& c = cols[k];
+      if (!(l[k] > 0.0) || !(moves(c.a) || moves(c.b))) continue;
+      if (c.edge) return Verdict::kCannotHold;
+      // A frictionless force on a moving member: its pair's normal acceleration 0 (to the
+      // at-rest bound), else the force pushes bodies that part and is no solution.
+      if (rel(c) > 1e-9 * amax) return Verdict::kCannotHold;
+    }
+    return Verdict::kHeld;
+  };
+  const Verdict v = verdict_of(acc, lam, false);
+  if (v != Verdict::kUndecided || C > kMaxExact || M > kMaxExact) return v;
+  // Gauss-Seidel had not converged (forces 1e7 times the weights, at contacts 1e-7 rad off
+  // the horizontal, crawl): the least-squares forces exactly (Lawson-Hanson's active set,
+  // each solve by Householder QR), and the same verdict on them.
+  thread_local std::vector<double> x;
+  thread_local std::vector<Vec2> acc2;
+  if (!exact_least_squares(w, members, C, [&](std::size_t k) { return std::tuple(cols[k].a, cols[k].b, cols[k].d); }, x)) {
+    return Verdict::kUndecided;
+  }
+  acc2.resize(M);
+  for (std::size_t q = 0; q < M; ++q) acc2[q] = w.acc[members[q]];
   for (std::size_t k = 0; k < C; ++k) {
     const Col& c = cols[k];
-    const Vec2 aa = c.a < 0 ? Vec2{} : acc[static_cast<std::size_t>(c.a)];
-    worst = std::min(worst, dot(acc[static_cast<std::size_t>(c.b)] - aa, c.d) / length(c.d));
+    if (x[k] == 0.0) continue;
+    if (c.a >= 0) acc2[static_cast<std::size_t>(c.a)] -= (x[k] * inv(c.a)) * c.d;
+    acc2[static_cast<std::size_t>(c.b)] += (x[k] * inv(c.b)) * c.d;
   }
-  double work = 0.0;
-  for (std::size_t q = 0; q < M; ++q) work += dot(w.acc[members[q]], acc[q]) / inv(static_cast<std::int32_t>(q));
-  return worst >= -1e-12 * amax && work > 0.0 ? Verdict::kCannotHold : Verdict::kUndecided;
+  const Verdict ve = verdict_of(acc2, x, true);
+  if (ve == Verdict::kCannotHold) {
+    residual = 0.0;
+    for (std::size_t q = 0; q < M; ++q) residual = std::max(residual, length(acc2[q]));
+  }
+  return ve;
 }
 
 }  // namespace
@@ -1572,6 +1860,8 @@ void push_trains(World& w) {
   thread_local std::vector<char> mixed, in_block;
   thread_local std::vector<TrainPair> pairs;
   w.train_stopping.clear();
+  for (std::uint32_t m : w.train_raw_list) w.train_raw_set[m] = 0;
+  w.train_raw_list.clear();
   train_pairs(w, pairs);
   if (pairs.empty()) return;
   root.resize(n);
@@ -1583,59 +1873,10 @@ void push_trains(World& w) {
     while (root[m] != m) m = root[m] = root[root[m]];
     return m;
   };
-  // The face's law for a rigid block: members (sorted along the face, so the sums are the
-  // same bits whatever the numbering) all move at the block's velocity v (the first
-  // member's: they agree to round-off) and acceleration a.
-  struct Law {
-    double M = 0.0, F = 0.0, H = 0.0, K = 0.0;
-  };
-  const auto law_of = [&](std::uint32_t m) {
-    const Vec2 nn = w.support_n[m], tt = perp(nn);
-    const Coefficients c = coefficients(w, m, w.statics.segments[w.support[m]]);
-    const double mass = 1.0 / w.inv_mass[m];
-    const double N = mass * std::max(-dot(w.acc[m], nn), 0.0);
-    return Law{mass, mass * dot(w.acc[m], tt), c.holding * N, c.moving * N};
-  };
-  const auto block_a = [](const Law& L, double v) {
-    if (v == 0.0) return std::fabs(L.F) <= L.H ? 0.0 : (L.F - std::copysign(L.K, L.F)) / L.M;
-    return (L.F - std::copysign(L.K, v)) / L.M;
-  };
-  // The push (per mass) giving member m the block's a: sliding, the difference to its own
-  // law; at rest and held (a == 0), each member's friction taking its share of the block's
-  // force in proportion to what it can hold.
-  const auto push_for = [&](std::uint32_t m, const Law& L, double v, double a) {
-    const Vec2 tt = perp(w.support_n[m]);
-    const Law own = law_of(m);
-    if (v != 0.0 || a != 0.0) {
-      const double own_a = (own.F - std::copysign(own.K, v != 0.0 ? v : L.F)) / own.M;
-      return (a - own_a) * tt;
-    }
-    const double share = L.H > 0.0 ? L.F * (own.H / L.H) : 0.0;
-    return ((share - own.F) / own.M) * tt;
-  };
-  // Pooling a chain (sorted along the face, all at velocity v) from the rear: a block behind
-  // that would accelerate faster along the face than the block in front presses it and
-  // joins it (a tie to round-off joins too, so the pair keeps the same bits).
-  struct Pool {
-    std::size_t b, e;
-    Law L;
-    double a;
-  };
+  const auto law_of = [&](std::uint32_t m) { return face_law(w, m, w.acc[m]); };
+  const auto push_for = [&](std::uint32_t m, const Law& L, double v, double a) { return block_push(w, m, w.acc[m], L, v, a); };
   const auto pool = [&](std::span<const std::uint32_t> chain, double v, std::vector<Pool>& pools) {
-    pools.clear();
-    for (std::size_t x = 0; x < chain.size(); ++x) {
-      const Law L = law_of(chain[x]);
-      pools.push_back({x, x + 1, L, block_a(L, v)});
-      while (pools.size() > 1) {
-        const Pool& back = pools[pools.size() - 2];
-        const Pool& front = pools.back();
-        if (!(back.a - front.a > -1e-12 * (std::fabs(back.a) + std::fabs(front.a)))) break;
-        Pool joined{back.b, front.e, {back.L.M + front.L.M, back.L.F + front.L.F, back.L.H + front.L.H, back.L.K + front.L.K}, 0.0};
-        joined.a = block_a(joined.L, v);
-        pools.pop_back();
-        pools.back() = joined;
-      }
-    }
+    pool_blocks(w, chain, v, false, pools);
   };
   thread_local std::vector<Pool> rest_pools;
   // Members of a block get its velocity and acceleration to the bit. static_push: at rest and
@@ -1659,6 +1900,7 @@ void push_trains(World& w) {
     for (std::uint32_t m : blk) {
       if (!(v == 0.0 && a == 0.0 && static_push)) push[m] = push_for(m, L, v, a);
       if (blk.size() > 1) in_block[m] = 1;
+      keep_raw_acc(w, m);
       w.acc[m] += push[m];
       push[m] = {};
       w.vel[m] = v * tt;
@@ -1772,6 +2014,7 @@ void push_trains(World& w) {
       if (!gs_pair(p)) continue;
       for (std::uint32_t m : {p.i, p.j}) {
         if (push[m].x == 0.0 && push[m].y == 0.0) continue;
+        keep_raw_acc(w, m);
         w.acc[m] += push[m];
         push[m] = {};
         support_path(w, m);
@@ -1855,6 +2098,111 @@ void apply_supports(World& w, const StepContext& ctx) {
   }
   judge_braced_holds(w);
   if (!w.varying_forces) push_trains(w);
+}
+
+bool join_train(World& w, std::span<const std::uint32_t> chain_in, std::uint32_t i, std::uint32_t j, double t, double vr,
+                std::vector<std::uint32_t>& moved) {
+  moved.clear();
+  if (w.varying_forces || w.any_rules || chain_in.size() < 2) return false;
+  const Vec2 tt = perp(w.support_n[i]);
+  thread_local std::vector<std::uint32_t> chain;
+  thread_local std::vector<double> along, vt;
+  chain.assign(chain_in.begin(), chain_in.end());
+  along.resize(w.size());
+  vt.resize(w.size());
+  for (std::uint32_t m : chain) {
+    along[m] = dot(w.pos_at(m, t), tt);
+    vt[m] = dot(w.vel_at(m, t), tt);
+  }
+  std::sort(chain.begin(), chain.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return along[a] < along[b] || (along[a] == along[b] && a < b);
+  });
+  // The perfectly inelastic impact of the chain: pooled from the rear by momentum (a block
+  // behind moving faster than the block in front meets it; a tie to round-off joins too).
+  struct Moving {
+    std::size_t b, e;
+    double M, P, v;
+  };
+  thread_local std::vector<Moving> blocks;
+  blocks.clear();
+  for (std::size_t x = 0; x < chain.size(); ++x) {
+    const std::uint32_t m = chain[x];
+    const double mass = 1.0 / w.inv_mass[m];
+    blocks.push_back({x, x + 1, mass, mass * vt[m], vt[m]});
+    while (blocks.size() > 1) {
+      const Moving& back = blocks[blocks.size() - 2];
+      const Moving& front = blocks.back();
+      if (!(back.v - front.v > -1e-12 * (std::fabs(back.v) + std::fabs(front.v)))) break;
+      const double M = back.M + front.M, P = back.P + front.P;
+      const Moving joined{back.b, front.e, M, P, P / M};
+      blocks.pop_back();
+      blocks.back() = joined;
+    }
+  }
+  const auto at = [&](std::uint32_t m) {
+    return static_cast<std::size_t>(std::find(chain.begin(), chain.end(), m) - chain.begin());
+  };
+  const std::size_t xi = at(i), xj = at(j);
+  const auto hit = std::find_if(blocks.begin(), blocks.end(), [&](const Moving& q) { return q.b <= xi && xi < q.e; });
+  if (hit == blocks.end() || !(hit->b <= xj && xj < hit->e)) return false;
+  const std::span<const std::uint32_t> blk = std::span<const std::uint32_t>(chain).subspan(hit->b, hit->e - hit->b);
+  double vmin = INFINITY, vmax = -INFINITY;
+  for (std::uint32_t m : blk) vmin = std::min(vmin, vt[m]), vmax = std::max(vmax, vt[m]);
+  const double spread = vmax - vmin;
+  // A slow impact onto a body at rest: its supports absorb it (as resolve_static).
+  const bool slow = std::fabs(vt[i] - vt[j]) < w.collapse_speed(i, j);
+  for (std::uint32_t m : blk) {
+    if (slow && w.stationary(m)) return false;
+  }
+  // No other pair of the block may bounce: none met faster than the spread.
+  for (std::size_t x = 0; x + 1 < blk.size(); ++x) {
+    const std::uint32_t a = blk[x], b = blk[x + 1];
+    if ((a == i && b == j) || (a == j && b == i)) continue;
+    const PairMaterial m = w.pair_material(w.material[a], w.material[b]);
+    const double e = spread < w.collapse_speed(a, b) ? 0.0 : m.restitution;
+    if (!(e * spread < vr)) return false;
+  }
+  const double v = hit->P / hit->M;
+  thread_local std::vector<Pool> pools, rest_pools;
+  pool_blocks(w, blk, v, true, pools);
+  for (std::uint32_t m : blk) {
+    end_substep(w, m, t);
+    std::erase(w.train_stopping, m);
+    moved.push_back(m);
+  }
+  // Each block as push_trains' set_block: its members at its velocity and acceleration to
+  // the bit, the pushes added to their force accelerations, and a block sliding to a stop
+  // its members' paths from rest.
+  const std::size_t n = w.size();
+  for (const Pool& q : pools) {
+    const std::span<const std::uint32_t> mem = blk.subspan(q.b, q.e - q.b);
+    const double a = q.a;
+    for (std::uint32_t m : mem) {
+      keep_raw_acc(w, m);
+      w.acc[m] = w.train_raw_acc[m];
+    }
+    if (mem.size() > 1 && v != 0.0 && a != 0.0 && (a > 0.0) != (v > 0.0)) {
+      if (w.train_stop_acc.size() < n) w.train_stop_acc.resize(n), w.train_stop_apath.resize(n), w.train_block.resize(n);
+      pool_blocks(w, mem, 0.0, true, rest_pools);
+      for (const Pool& r : rest_pools) {
+        for (std::size_t x = r.b; x < r.e; ++x) {
+          const std::uint32_t m = mem[x];
+          w.train_stop_acc[m] = w.acc[m] + block_push(w, m, w.acc[m], r.L, 0.0, r.a);
+          w.train_stop_apath[m] = r.a * tt;
+          w.train_block[m] = mem[0];
+          w.train_stopping.push_back(m);
+        }
+      }
+    }
+    for (std::uint32_t m : mem) {
+      w.acc[m] += block_push(w, m, w.acc[m], q.L, v, a);
+      w.vel[m] = v * tt;
+      support_path(w, m);
+      w.vel[m] = v * tt;
+      w.apath[m] = a * tt;
+    }
+  }
+  return true;
 }
 
 double support_stop_time(const World& w, std::uint32_t i, double t, double T) {

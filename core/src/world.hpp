@@ -170,6 +170,12 @@ struct World {
   std::vector<Vec2> train_stop_acc, train_stop_apath;
   std::vector<std::uint32_t> train_stopping;   // the bodies that have them
   std::vector<std::uint32_t> train_block;      // their block (its first member), to stop as one
+  // push_trains adds pushes to acc for the step: each pushed body's force acceleration
+  // before them (train_raw_set: it has one this step; train_raw_list: those bodies), so
+  // that join_train can judge a block again from the members' own laws.
+  std::vector<Vec2> train_raw_acc;
+  std::vector<char> train_raw_set;
+  std::vector<std::uint32_t> train_raw_list;
   // varying_forces: each body's current sub-step. A step is one sub-step unless an
   // impact (or a lift-off) changes the body's velocity inside it; the integrator then
   // starts a new sub-step there (substeps.cpp). Its start time, state and acceleration:
@@ -367,6 +373,20 @@ void support_path(World& w, std::uint32_t i);
 // Body i on a face comes to rest (its friction stop): its path from rest (a train's
 // member: the one push_trains found for its block from rest).
 void stop_on_support(World& w, std::uint32_t i);
+// A slow, pressed impact of bodies i and j (touching at t, both on faces of one normal,
+// the pair's normal along the face; vr: the pair's rest speed) that `chain` (i, j and
+// every body touching them along the face, transitively; all on faces of that normal,
+// free, touching nothing else) would set moving as one: the members that the perfectly
+// inelastic impact gives one velocity (pooled from the rear as momentum: a block behind
+// moving faster than the one in front joins it) share their momentum and move on as
+// push_trains' blocks for the rest of the step (pooled from the rear by the face's law
+// at that velocity, each block's members at its velocity and acceleration to the bit,
+// with their paths from rest if it stops). False, nothing changed, when some pair of
+// them would bounce (restitution above the rest speed), a body at rest would be met
+// slower than the collapse speed (its supports absorb it), or the forces vary. Else
+// true, `moved` the members (advanced to t) whose paths changed.
+bool join_train(World& w, std::span<const std::uint32_t> chain, std::uint32_t i, std::uint32_t j, double t, double vr,
+                std::vector<std::uint32_t>& moved);
 // The other members of body i's block sliding to a stop (they stop with it, at once).
 void stopping_mates(const World& w, std::uint32_t i, std::vector<std::uint32_t>& out);
 // The support's law for body i on its segment: the acceleration along the face under

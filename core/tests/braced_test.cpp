@@ -129,6 +129,43 @@ TEST(CoreBraced, TwoLayersBetweenWallsHoldIffTheFloorFrictionSays) {
 }
 
 
+// A column of two frictionless balls on a frictionless floor (base, top), and a third ball
+// at rest touching the top one's side, its centre phi above the top's: it falls (phi = 0:
+// past the top, touching only at the start) or slides down the top's side pushing it
+// sideways by m g sin(phi) cos(phi) (phi > 0). The top is held on the base, which other
+// bodies touch, so its hold is judged on the whole component, the moving ball included.
+// Rigid Coulomb: with a wall at the column's left the wall takes every push (held); without,
+// the column is held iff nothing pushes it sideways (phi = 0). The judgement once reported
+// phi = 0 as a hold that cannot hold (the falling ball cannot be at rest: 9.8 m/s^2 left on
+// it, nothing on the column), and the column's hold as a broken guarantee.
+TEST(CoreBraced, ABallMovingAlongAHeldColumnBreaksItsHoldIffItPushesItOver) {
+  for (bool wall_left : {true, false}) {
+    for (double phi_deg : {0.0, 10.0, 30.0}) {
+      SCOPED_TRACE(std::string(wall_left ? "wall at the left" : "no wall") + ", phi " + std::to_string(phi_deg));
+      const double phi = phi_deg * M_PI / 180.0;
+      const Vec2 top{r, 3.0 * r};
+      std::vector<BodyDef> b = {circle("base", {r, r}, {}, r, 1.0, 0.0), circle("top", top, {}, r, 1.0, 0.0),
+                                circle("mover", top + 2.0 * r * Vec2{std::cos(phi), std::sin(phi)}, {}, r, 1.0, 0.0)};
+      std::vector<WallDef> walls = {wall("floor", {-50.0, 0.0}, {50.0, 0.0}, 0.0, 0.0)};
+      if (wall_left) walls.push_back(wall("lw", {0.0, 5.0}, {0.0, 0.0}, 0.0, 0.0));
+      Sim sim(scene_of(b, walls, {0.0, -g}));
+      sim.step(1.0 / 60.0);
+      const std::string report = sim.engine.broken_guarantee();
+      const bool holds = wall_left || phi_deg == 0.0;
+      EXPECT_EQ(report.empty(), holds) << report;
+      if (!holds) {
+        EXPECT_NE(report.find("'top'"), std::string::npos) << report;
+        EXPECT_NE(report.find("cannot hold it"), std::string::npos) << report;
+      } else {
+        EXPECT_EQ(sim.state("top").position, top);
+        EXPECT_EQ(sim.state("top").velocity, Vec2{});
+        EXPECT_LT(sim.state("mover").velocity.y, 0.0);   // it moves on
+      }
+    }
+  }
+}
+
+
 // Columns of touching balls on a floor (radii 0.5 and 0.3 alternating), masses graded over
 // up to 9 decades, heaviest on top, at the bottom or mixed, e 0, 0.5, 1 (the hunt's grid
 // `stack`): held exactly, nothing moves, nothing reported. At 1e9 the group judgement said

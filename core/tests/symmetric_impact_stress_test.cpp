@@ -252,15 +252,11 @@ TEST_P(SymmetricImpactStress, SymmetricWhateverTheNumberingAndNoEnergyGain) {
       const bool must_spread = c.name == "ball_on_stack_of_three" && mu < 0.13;
       EXPECT_EQ(ref.unjustified, must_spread) << what;
       if (must_spread) continue;
-      // Not yet: on a frictionless floor (mu = 0 with gravity) bodies sliding on the
-      // floor are left out of simultaneous sets (with them, a frictionless 10-circle pile,
-      // seed 3, never settled), so the lower balls meet the top one pair by pair in body
-      // order and the answer depends on the numbering (up to 2 mm here). Energy and
-      // momentum are still checked there.
-      const bool not_yet = c.floor && mu == 0.0;
+      // On a frictionless floor (mu = 0 with gravity) too: bodies sliding on it take part in
+      // the simultaneous sets (they were left out, and the answer depended on the numbering
+      // by up to 2 mm here).
       // The scene's own symmetries, to 1e-12.
       for (const Symmetry& s : c.symmetries) {
-        if (not_yet) break;
         double worst = 0.0;
         for (std::size_t k = 0; k < n; ++k) {
           const std::size_t m = static_cast<std::size_t>(s.perm[k]);
@@ -278,9 +274,7 @@ TEST_P(SymmetricImpactStress, SymmetricWhateverTheNumberingAndNoEnergyGain) {
           if (mirror) tag += " mirrored";
           EXPECT_TRUE(f.failure.empty()) << tag << ": " << f.failure;
           EXPECT_FALSE(f.unjustified) << tag;
-          if (!not_yet) {
-            EXPECT_LE(worst_difference(f, ref), 1e-12) << tag;
-          }
+          EXPECT_LE(worst_difference(f, ref), 1e-12) << tag;
         }
       } while (std::next_permutation(order.begin(), order.end()));
     }
