@@ -130,6 +130,69 @@ final = [ { body = "shell", velocity = [1.0, 0.0], position = [0.5, 0.0] } ]
   }
 }
 
+// contact_time_error is the largest error of the contacts matched; a contact more than
+// the matching window (max(5 dt, 0.05 s)) off is missed instead. A ball bouncing on a floor
+// at e = 0.95 for 8 s: Box2D's bounces drift, three of them beyond the window, and its
+// contact_time_error read 0.039 s: `[gate] contact_time_error = 0.04` passed (exit 0) with
+// three bounces missed. Without a missed_contacts limit beside it, a timing limit now holds
+// every reference contact to be matched.
+TEST_F(VacuousChecks, AContactTimeLimitFailsWhenAContactIsMissed) {
+  const std::string bounce = R"(name = "bounce"
+duration = 8.0
+dt = "1/60"
+[world]
+gravity = [0.0, -9.81]
+[[bodies]]
+name = "ball"
+radius = 0.5
+position = [0.0, 5.0]
+restitution = 0.95
+[[walls]]
+name = "floor"
+from = [-5.0, 0.0]
+to = [5.0, 0.0]
+restitution = 0.95
+[gate]
+contact_time_error = 0.04
+)";
+  const fs::path f = write("bounce.toml", bounce);
+  const Result r = physval("gate " + f.string() + out());
+  EXPECT_EQ(r.status, 1) << r.output;
+  int hidden = 0, runs = 0;
+  {
+    const nlohmann::json all = results();
+    for (const nlohmann::json& run : all["runs"]) {
+      if (run["status"] != "ok") continue;
+      ++runs;
+      const nlohmann::json& m = run["metrics"];
+      ASSERT_TRUE(m["missed_contacts"].is_number()) << run.dump();
+      const double missed = m["missed_contacts"].get<double>();
+      for (const nlohmann::json& c : run["checks"]) {
+        if (c["what"] != "contact_time_error") continue;
+        if (missed > 0) {
+          EXPECT_FALSE(c["pass"].get<bool>()) << run.dump();
+          if (m["contact_time_error"].is_number() && m["contact_time_error"].get<double>() <= 0.04) ++hidden;
+        } else {
+          EXPECT_EQ(c["pass"].get<bool>(), m["contact_time_error"].get<double>() <= 0.04) << run.dump();
+        }
+      }
+    }
+  }
+  EXPECT_EQ(runs, 5);
+  EXPECT_GE(hidden, 1) << "a run whose matched contacts met the limit while it missed others (Box2D)";
+  // With a missed_contacts limit the two are separate limits, as before.
+  const fs::path g = write("bounce.toml", bounce + "missed_contacts = 10\n");
+  physval("gate " + g.string() + out());
+  const nlohmann::json all = results();
+  for (const nlohmann::json& run : all["runs"]) {
+    for (const nlohmann::json& c : run["checks"]) {
+      if (c["what"] == "contact_time_error") {
+        EXPECT_EQ(c["pass"].get<bool>(), run["metrics"]["contact_time_error"].get<double>() <= 0.04) << run.dump();
+      }
+    }
+  }
+}
+
 // A static body given a velocity (a "moving post") stood still on every engine, and the
 // scene ran `ok`: the key said something no run did. It is bad input now, as is a thrust
 // table on a static body.
