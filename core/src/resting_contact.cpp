@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "physval/core/time_of_impact.hpp"
+#include "nnls.hpp"
 #include "world.hpp"
 
 namespace physval::core_detail {
@@ -1071,14 +1072,14 @@ bool resting_component(World& w, const BodiesByX& bx, std::uint32_t seed, std::v
 // (column k: a force along d on member b, minus it on member a; a < 0: a fixed support)
 // minimising sum_q m_q |a_q|^2, a_q a member's force acceleration plus its forces over its
 // mass, i.e. min |B x - y| in mass-weighted form (B's rows sqrt(1/m) d, y = -sqrt(m) a).
-// Lawson and Hanson's active-set method; each unconstrained solve on the active columns by
-// Householder QR. False if it does not finish (3 C + 30 additions) or an active set is
-// singular.
+// Lawson and Hanson's active-set method (nnls.hpp); each unconstrained solve on the active
+// columns by Householder QR. False if it does not finish (3 C + 30 additions) or an active
+// set is singular.
 template <class ColFn>
 bool exact_least_squares(const World& w, std::span<const std::uint32_t> members, std::size_t C, ColFn col,
                          std::vector<double>& x) {
   const std::size_t M = members.size(), R = 2 * M;
-  std::vector<double> B(R * C, 0.0), y(R), z(C), wv(C), res(R);
+  std::vector<double> B(R * C, 0.0), y(R);
   const auto at = [&](std::size_t row, std::size_t k) -> double& { return B[k * R + row]; };
   for (std::size_t k = 0; k < C; ++k) {
     const auto [a, b, d] = col(k);
@@ -1091,112 +1092,12 @@ bool exact_least_squares(const World& w, std::span<const std::uint32_t> members,
       at(2 * static_cast<std::size_t>(a) + 1, k) -= sa * d.y;
     }
   }
-  double ynorm = 0.0;
   for (std::size_t q = 0; q < M; ++q) {
     const double s = -1.0 / std::sqrt(w.inv_mass[members[q]]);
     y[2 * q] = s * w.acc[members[q]].x;
     y[2 * q + 1] = s * w.acc[members[q]].y;
-    ynorm = std::max({ynorm, std::fabs(y[2 * q]), std::fabs(y[2 * q + 1])});
   }
-  x.assign(C, 0.0);
-  std::vector<char> active(C, 0);
-  std::vector<std::size_t> P;
-  std::vector<double> Q, rhs;
-  // z = the least-squares solution on the active columns (0 elsewhere); false if singular.
-  const auto solve = [&]() {
-    const std::size_t n = P.size();
-    Q.assign(R * n, 0.0);
-    for (std::size_t j = 0; j < n; ++j) {
-      for (std::size_t i = 0; i < R; ++i) Q[j * R + i] = at(i, P[j]);
-    }
-    rhs = y;
-    double scale = 0.0;
-    for (double v : Q) scale = std::max(scale, std::fabs(v));
-    for (std::size_t j = 0; j < n; ++j) {   // Householder on column j, rows j..R-1
-      if (j >= R) return false;
-      double norm = 0.0;
-      for (std::size_t i = j; i < R; ++i) norm += Q[j * R + i] * Q[j * R + i];
-      norm = std::sqrt(norm);
-      if (!(norm > 1e-13 * scale)) return false;
-      const double alpha = Q[j * R + j] > 0.0 ? -norm : norm;
-      std::vector<double> v(R - j);
-      for (std::size_t i = j; i < R; ++i) v[i - j] = Q[j * R + i];
-      v[0] -= alpha;
-      double vv = 0.0;
-      for (double e : v) vv += e * e;
-      if (!(vv > 0.0)) continue;
-      for (std::size_t jj = j; jj < n; ++jj) {
-        double s = 0.0;
-        for (std::size_t i = j; i < R; ++i) s += v[i - j] * Q[jj * R + i];
-        s *= 2.0 / vv;
-        for (std::size_t i = j; i < R; ++i) Q[jj * R + i] -= s * v[i - j];
-      }
-      double s = 0.0;
-      for (std::size_t i = j; i < R; ++i) s += v[i - j] * rhs[i];
-      s *= 2.0 / vv;
-      for (std::size_t i = j; i < R; ++i) rhs[i] -= s * v[i - j];
-    }
-    std::fill(z.begin(), z.end(), 0.0);
-    for (std::size_t j = n; j-- > 0;) {
-      double s = rhs[j];
-      for (std::size_t jj = j + 1; jj < n; ++jj) s -= Q[jj * R + j] * z[P[jj]];
-      z[P[j]] = s / Q[j * R + j];
-    }
-    return true;
-  };
-  const auto gradient = [&]() {   // wv = B^T (y - B x)
-    res = y;
-    for (std::size_t k = 0; k < C; ++k) {
-      if (x[k] == 0.0) continue;
-      for (std::size_t i = 0; i < R; ++i) res[i] -= at(i, k) * x[k];
-    }
-    for (std::size_t k = 0; k < C; ++k) {
-      double s = 0.0;
-      for (std::size_t i = 0; i < R; ++i) s += at(i, k) * res[i];
-      wv[k] = s;
-    }
-  };
-  gradient();
-  for (std::size_t outer = 0; outer < 3 * C + 30; ++outer) {
-    std::size_t t = C;
-    double best = 1e-13 * ynorm;
-    for (std::size_t k = 0; k < C; ++k) {
-      if (!active[k] && wv[k] > best) {
-        best = wv[k];
-        t = k;
-      }
-    }
-    if (t == C) return true;   // no column would lower the residual: optimal
-    active[t] = 1;
-    P.push_back(t);
-    for (int inner = 0;; ++inner) {
-      if (inner > static_cast<int>(C) + 10 || !solve()) return false;
-      bool positive = true;
-      for (std::size_t k : P) positive = positive && z[k] > 0.0;
-      if (positive) {
-        for (std::size_t k : P) x[k] = z[k];
-        break;
-      }
-      double alpha = 1.0;
-      for (std::size_t k : P) {
-        if (z[k] <= 0.0) alpha = std::min(alpha, x[k] / (x[k] - z[k]));
-      }
-      for (std::size_t k : P) x[k] += alpha * (z[k] - x[k]);
-      std::vector<std::size_t> keep;
-      for (std::size_t k : P) {
-        if (x[k] > 0.0) {
-          keep.push_back(k);
-        } else {
-          x[k] = 0.0;
-          active[k] = 0;
-        }
-      }
-      P = keep;
-      if (P.empty()) break;
-    }
-    gradient();
-  }
-  return false;
+  return nnls(R, C, B, y, x);
 }
 
 // Whether a resting component (sorted members; faces and static bodies fixed) can be held

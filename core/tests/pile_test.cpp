@@ -349,10 +349,16 @@ INSTANTIATE_TEST_SUITE_P(Piles, CorePileSettles,
 // e 0.9 and seed 2 components checked by scipy, HiGHS infeasible and NNLS leaving a held body
 // accelerating), e 0.3 and 0.6 of seed 1 settle unreported.
 constexpr const char* kWedged = "a ball wedged on balls a frictionless floor lets slide";
+constexpr const char* kFrictionlessGroup = "a frictionless group core holds (reported, cause not analysed)";
 INSTANTIATE_TEST_SUITE_P(FrictionlessPiles, CorePileSettles,
                          ::testing::Values(PileCase{10, 0.0, 1, 0.0, kWedged}, PileCase{10, 0.3, 1, 0.0, kWedged},
                                            PileCase{10, 0.6, 1, 0.0, kWedged}, PileCase{10, 0.9, 1, 0.0, kWedged},
-                                           PileCase{10, 0.3, 2, 0.0, kWedged}, PileCase{10, 0.3, 3, 0.0, kWedged}),
+                                           PileCase{10, 0.3, 2, 0.0, kWedged}, PileCase{10, 0.3, 3, 0.0, kWedged},
+                                           // 50 circles at e 0.9, seed 3: sets of nearly collinear
+                                           // contacts Gauss-Seidel could not solve (branch pgsfix:
+                                           // solved exactly by non-negative least squares); p0 at
+                                           // 1.35 s (24 bodies, 9.8 m/s^2; not analysed further)
+                                           PileCase{50, 0.9, 3, 0.0, kFrictionlessGroup}),
                          [](const auto& test_info) {
                            return "n" + std::to_string(test_info.param.n) + "_e" +
                                   std::to_string(static_cast<int>(test_info.param.e * 10)) + "_seed" +
