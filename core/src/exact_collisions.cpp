@@ -869,7 +869,7 @@ class EventLoop {
     } else if (slow && face && !own_support && !w_.stationary(i) && hold(i)) {
       // Pressed into a second face (a corner, a V) or a face beside bodies at rest:
       // held at rest there if its contacts together can hold it.
-    } else if (slow && face && !w_.supported(i) && !w_.any_rules && touches_another_face(i, k) &&
+    } else if (slow && face && !w_.supported(i) && !w_.any_rules && touches_another_face(i, k, n) &&
                resolve_simultaneous(w_, i, kSimultaneousFace | k, t, set_, impacted_)) {
       // A free body meeting two faces at one instant (a V, a corner) too slowly to bounce
       // clear: Newton's law at both at once (settling on the first face found and then
@@ -918,8 +918,12 @@ class EventLoop {
   }
 
   // Whether body i (advanced to now) touches a face other than k, at rest or closing (the
-  // same round-off window as the simultaneous set's contacts).
-  bool touches_another_face(std::uint32_t i, std::uint32_t k) {
+  // same round-off window as the simultaneous set's contacts), along another normal than
+  // k's contact normal `nk`: the next piece of a floor drawn in pieces (a junction) is the
+  // same support, not a V. (Taken as a V, a ball sliding across a junction met both at
+  // once, the simultaneous law changed nothing and left it free, the next piece was met
+  // again at the same instant, for ever: the event cap.)
+  bool touches_another_face(std::uint32_t i, std::uint32_t k, Vec2 nk) {
     const Vec2 p = w_.pos[i];
     const double r = w_.radius[i];
     const double pad = r * (1.0 + 1e-9) + 1024.0 * 2.220446049250313e-16 * (std::max(std::fabs(p.x), std::fabs(p.y)) + w_.length_scale);
@@ -936,6 +940,7 @@ class EventLoop {
                            std::max(std::fabs(s.to.x), std::fabs(s.to.y));
       if (std::fabs(D) - r > 1024.0 * 2.220446049250313e-16 * scale) continue;
       const Vec2 n = D >= 0.0 ? s.normal : -s.normal;
+      if (dot(n, nk) >= 1.0 - 1e-12) continue;
       if (dot(w_.vel[i], n) <= 1024.0 * 2.220446049250313e-16 * length(w_.vel[i])) return true;
     }
     return false;

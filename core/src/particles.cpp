@@ -19,6 +19,7 @@
 #include <cmath>
 #include <string>
 
+#include "physval/core/time_of_impact.hpp"
 #include "world.hpp"
 
 namespace physval::core_detail {
@@ -58,6 +59,51 @@ void spawn(World& w, EmitterState& e, std::uint16_t emitter, Vec2 p, Vec2 v, dou
   w.parent.push_back(parent);
   w.emitter_of.push_back(emitter);
   w.serial.push_back(e.serial++);
+}
+
+// Whether a particle's ballistic path from (p, v) under g over s seconds meets a
+// barrier (a wall, box side or surface segment) or a static body it collides with.
+// (`statics`: the scene's static bodies; `found`: scratch for the segments' query.)
+bool placement_meets_barrier(const World& w, const std::vector<std::uint32_t>& statics, std::vector<std::uint32_t>& found,
+                             std::uint16_t group, Vec2 p, Vec2 v, Vec2 g, double s) {
+  if (!(s > 0.0)) return false;
+  // The path's box: its chord's, widened by the parabola's largest distance from it.
+  const Vec2 q = p + s * v + (0.5 * s * s) * g;
+  const double pad = 0.125 * s * s * length(g) + 1e-9 * (w.length_scale + std::fabs(p.x) + std::fabs(p.y));
+  found.clear();
+  w.statics.query(make_aabb(std::min(p.x, q.x) - pad, std::min(p.y, q.y) - pad, std::max(p.x, q.x) + pad,
+                            std::max(p.y, q.y) + pad),
+                  found);
+  for (std::uint32_t k : found) {
+    const Segment& seg = w.statics.segments[k];
+    if (!w.response(group, seg.group).collide) continue;
+    if (toi::circle_segment(p, v, g, 0.0, seg.from, seg.to, s, w.length_scale, g).s != toi::kNever) return true;
+  }
+  const double speed = length(v) + length(g) * s;
+  for (std::uint32_t i : statics) {
+    if (!w.alive(i) || !w.response(group, w.group[i]).collide) continue;
+    const double R = w.radius[i];
+    if (toi::circle_circle(p - w.pos[i], v, g, R, s, toi::squared_tolerance(w.length_scale, speed, R)) != toi::kNever) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// A particle born at `birth` within the step that ends at t_end starts where its
+// ballistic path has taken it by then: exact while that path meets nothing it collides
+// with. A path that meets a barrier is not followed through it (placed beyond, a particle
+// at 500 m/s left a closed 4 m box in one 1/60 s step, and the run was `ok`): such a
+// particle starts at t_end from its emission point and velocity instead (late by at most
+// one step, a first-order error in its own path), and its impact comes in the next step.
+void spawn_from(World& w, const std::vector<std::uint32_t>& statics, EmitterState& e, std::uint16_t emitter, Vec2 p,
+                Vec2 v0, Vec2 g, double s, double birth) {
+  thread_local std::vector<std::uint32_t> found;
+  if (placement_meets_barrier(w, statics, found, w.group[e.parent], p, v0, g, s)) {
+    spawn(w, e, emitter, p, v0, birth);
+  } else {
+    spawn(w, e, emitter, p + s * v0 + (0.5 * s * s) * g, v0 + s * g, birth);
+  }
 }
 
 }  // namespace
@@ -101,6 +147,11 @@ void record_emission(World& w, std::uint32_t emitter, Vec2 position, Vec2 veloci
 
 void finish_particles(World& w, const StepContext& ctx) {
   const double t_end = ctx.t0 + ctx.dt;
+  thread_local std::vector<std::uint32_t> statics;   // the static bodies, for spawn_from
+  statics.clear();
+  for (std::uint32_t i = 0; i < w.scene_bodies; ++i) {
+    if (w.is_static(i)) statics.push_back(i);
+  }
   for (std::size_t k = 0; k < w.emitters.size(); ++k) {
     EmitterState& e = w.emitters[k];
     const auto id = static_cast<std::uint16_t>(k);
@@ -113,7 +164,7 @@ void finish_particles(World& w, const StepContext& ctx) {
       const Vec2 g = e.def.gravity ? w.gravity : Vec2{};
       for (int c = 0; c < e.def.count; ++c) {
         const Vec2 v0 = e.at_velocity + in_disc(e.rng, e.def.speed);
-        spawn(w, e, id, e.at_position + s * v0 + (0.5 * s * s) * g, v0 + s * g, e.at_time);
+        spawn_from(w, statics, e, id, e.at_position, v0, g, s, e.at_time);
       }
     } else {
       if (!(e.def.rate > 0.0)) continue;
@@ -122,7 +173,7 @@ void finish_particles(World& w, const StepContext& ctx) {
       for (const EmitterState::Emission& em : e.emitted) {   // exact mode, in time order
         const double s = t_end - em.time;
         const Vec2 v0 = em.velocity + in_disc(e.rng, e.def.speed);
-        spawn(w, e, id, em.position + s * v0 + (0.5 * s * s) * g, v0 + s * g, em.time);
+        spawn_from(w, statics, e, id, em.position, v0, g, s, em.time);
       }
       e.emitted.clear();
       e.next_emit = static_cast<double>(e.serial + 1) * period;   // no drift from summing

@@ -262,7 +262,12 @@ SegmentHit circle_segment(Vec2 p, Vec2 v, Vec2 a, double r, Vec2 from, Vec2 to, 
     const double end_tol = lin.touch;
     const bool leaving_end = s == 0.0 && std::fabs(g.c[1]) <= lin.slope &&
                              ((u >= L - end_tol && ut > 0.0) || (u <= end_tol && ut < 0.0));
-    if (u >= 0.0 && u <= L && !leaving_end) {
+    // The span is closed to the coordinates' round-off too: a point sliding off one
+    // segment of a floor onto the next (a junction) is released at the first one's end,
+    // computed along it, a hair (1e-16 m) before the next one's start; read strictly, that
+    // face was never met and the point fell through the floor at the junction (a circle
+    // meets the end point instead; a point has no cap).
+    if (u >= -end_tol && u <= L + end_tol && !leaving_end) {
       hit.s = s;
       hit.normal = sg * n;
       hit.cap = false;

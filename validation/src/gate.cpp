@@ -26,10 +26,14 @@ std::string g(double v) {
   return os.str();
 }
 
-// Metrics where bigger is worse and a baseline comparison makes sense.
+// Metrics where bigger is worse and a baseline comparison makes sense. The contact
+// counts, the penetration and the energy gain are among them: a contact an engine now
+// misses leaves contact_time_error smaller (it is the error of the contacts matched), and
+// an overlap 100x deeper changed no other metric.
 constexpr const char* kErrorMetrics[] = {
     "energy_drift", "linear_momentum_drift", "angular_momentum_drift", "energy_divergence",
-    "linear_momentum_divergence", "position_divergence", "contact_time_error"};
+    "linear_momentum_divergence", "position_divergence", "contact_time_error",
+    "missed_contacts", "extra_contacts", "max_penetration", "energy_gain"};
 
 // JUnit's timestamp: ISO 8601 without a zone (the Jenkins/Surefire schema's xs:dateTime
 // pattern), in UTC.
@@ -70,7 +74,7 @@ std::string junit_xml(const SuiteResult& result) {
       total_time += r.wall_seconds;
       cases << "    <testcase classname=\"physval." << xml_escape(sr.scene.name) << "\" name=\"" << xml_escape(r.engine)
             << "\" time=\"" << r.wall_seconds << "\">\n";
-      if (r.status == RunStatus::Unsupported) {
+      if (r.status == RunStatus::Unsupported && r.passed()) {
         ++skipped;
         cases << "      <skipped message=\"" << xml_escape(r.reason) << "\"/>\n";
       } else if (r.status == RunStatus::Error) {
@@ -122,6 +126,25 @@ int apply_baseline(SuiteResult& result, const nlohmann::json& baseline, double f
       auto it = old.find({r.scenario, r.engine});
       if (it == old.end() || !it->second->contains("metrics")) continue;
       ++matched;
+      // An engine that ran the scenario in the baseline and now cannot model it (a plugin
+      // that dropped a feature, a scene that gained one) checks nothing: every regression
+      // the baseline would catch is hidden, so the run fails (it passed as "unsupported").
+      if (r.status == RunStatus::Unsupported) {
+        const nlohmann::json& old_run = *it->second;
+        const std::string before = old_run.contains("status") && old_run["status"].is_string()
+                                       ? old_run["status"].get<std::string>() : std::string("unsupported");
+        if (before != "unsupported") {
+          Check c;
+          c.what = "baseline.status";
+          c.limit = 0.0;
+          c.value.reset();
+          c.pass = false;
+          c.enforced = true;
+          c.detail = "the baseline ran it (status " + before + "); this run did not (" + r.reason + ")";
+          r.checks.push_back(c);
+        }
+        continue;
+      }
       // A baseline measured at another dt is not this run's: its numbers mean nothing here.
       if (const nlohmann::json& old_run = *it->second; old_run.contains("dt") && old_run["dt"].is_number()) {
         const double old_dt = old_run["dt"].get<double>();

@@ -752,6 +752,16 @@ void check_references(Context& ctx, const toml::table& root, Scene& s) {
     if (s.bodies[i].is_static && s.bodies[i].shape == ShapeKind::Point) {
       ctx.error(where("bodies", i), indexed("bodies", i) + ".static", "a static body must be a circle");
     }
+    // A static body is immovable: every engine ignored a velocity or a thrust given to it
+    // (a "moving post" stood still on all five, and the scene was `ok`), so such a key
+    // says something that no run does.
+    if (s.bodies[i].is_static && (s.bodies[i].velocity.x != 0.0 || s.bodies[i].velocity.y != 0.0)) {
+      ctx.error(where("bodies", i, "velocity"), indexed("bodies", i) + ".velocity",
+                "a static body does not move (physval has no kinematic bodies): its velocity must be [0, 0]");
+    }
+    if (s.bodies[i].is_static && s.bodies[i].thrust.enabled()) {
+      ctx.error(where("bodies", i, "thrust"), indexed("bodies", i) + ".thrust", "a static body does not move: it takes no thrust");
+    }
   }
 }
 

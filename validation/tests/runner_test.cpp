@@ -389,3 +389,74 @@ TEST(Gate, BaselineFailsWhenAMeasuredMetricIsNoLongerMeasured) {
 
 }  // namespace
 }  // namespace physval
+
+namespace physval {
+namespace {
+
+// An engine that ran a scenario in the baseline and now reports it unsupported (a plugin
+// that dropped a feature, a scene that gained one) checked nothing, and `gate
+// --baseline` passed it: an unsupported run always passed, whatever its checks said.
+TEST(Gate, BaselineFailsWhenAnEngineThatRanIsNowUnsupported) {
+  for (const std::string before : {"ok", "diverged", "unsupported"}) {
+    SuiteResult result;
+    ScenarioResult sr;
+    sr.scene = two_bodies();
+    sr.runs = {unsupported_run(sr.scene, fake(Fault::None).info, {"particles"})};
+    result.scenarios.push_back(sr);
+    const nlohmann::json metrics = before == "unsupported" ? nlohmann::json::object()
+                                                           : nlohmann::json{{"energy_drift", 1e-6}};
+    const nlohmann::json baseline = {
+        {"runs", {{{"scenario", "two"}, {"engine", "fake"}, {"status", before}, {"metrics", metrics}}}}};
+    EXPECT_EQ(apply_baseline(result, baseline, 2.0), 1);
+    const RunRecord& r = result.scenarios[0].runs[0];
+    const std::string xml = junit_xml(result);
+    if (before == "unsupported") {
+      EXPECT_TRUE(r.passed());
+      EXPECT_TRUE(r.checks.empty());
+      EXPECT_NE(xml.find("<skipped"), std::string::npos) << xml;
+    } else {
+      EXPECT_FALSE(r.passed()) << before;
+      ASSERT_EQ(r.checks.size(), 1u);
+      EXPECT_EQ(r.checks[0].what, "baseline.status");
+      EXPECT_NE(r.checks[0].detail.find("status " + before), std::string::npos) << r.checks[0].detail;
+      EXPECT_EQ(xml.find("<skipped"), std::string::npos) << xml;
+      EXPECT_NE(xml.find("failures=\"1\""), std::string::npos) << xml;
+      EXPECT_NE(xml.find("baseline.status"), std::string::npos) << xml;
+    }
+  }
+}
+
+// A contact an engine now misses left contact_time_error smaller (it is the largest error
+// of the contacts matched), and an overlap 100x deeper changed no metric the baseline
+// compared: both passed `gate --baseline`.
+TEST(Gate, BaselineFailsOnANewlyMissedContactOrADeeperOverlap) {
+  struct Case { const char* metric; double before, now; bool pass; };
+  for (const Case& k : {Case{"missed_contacts", 0.0, 1.0, false}, Case{"extra_contacts", 0.0, 2.0, false},
+                        Case{"max_penetration", 1e-4, 1e-2, false}, Case{"energy_gain", 1e-6, 1e-3, false},
+                        Case{"missed_contacts", 1.0, 2.0, true}, Case{"max_penetration", 1e-4, 1.5e-4, true}}) {
+    SuiteResult result;
+    ScenarioResult sr;
+    sr.scene = two_bodies();
+    RunRecord r = run_engine(sr.scene, fake(Fault::None), RunOptions{});
+    r.metrics["contact_time_error"] = 1e-3;
+    r.metrics[k.metric] = k.now;
+    sr.runs = {r};
+    result.scenarios.push_back(sr);
+    const nlohmann::json baseline = {{"runs", {{{"scenario", "two"}, {"engine", "fake"},
+                                                {"metrics", {{"contact_time_error", 2e-3}, {k.metric, k.before}}}}}}};
+    EXPECT_EQ(apply_baseline(result, baseline, 2.0), 1);
+    bool saw = false;
+    for (const Check& c : result.scenarios[0].runs[0].checks) {
+      if (c.what == "baseline.contact_time_error") {
+        EXPECT_TRUE(c.pass);
+      }
+      if (c.what != std::string("baseline.") + k.metric) continue;
+      saw = true;
+      EXPECT_EQ(c.pass, k.pass) << k.metric << " " << k.before << " -> " << k.now;
+    }
+    EXPECT_TRUE(saw) << k.metric;
+  }
+}
+
+}  // namespace
+}  // namespace physval
