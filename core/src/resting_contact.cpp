@@ -1199,13 +1199,28 @@ Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint
   // under one of 1e9 kg in a column (held exactly) was never "at rest": 1e-9 of g is 1e-19
   // of the forces on it, and the run was reported as a hold core could not show.
   thread_local std::vector<double> force_sum;
-  const auto all_at_rest = [&](std::span<const Vec2> a, std::span<const double> l) {
+  // force_sum: each member's contact forces l summed as magnitudes over its mass.
+  const auto sum_forces = [&](std::span<const double> l) {
     force_sum.assign(M, 0.0);
     for (std::size_t k = 0; k < C; ++k) {
       const double f = std::fabs(l[k]) * length(cols[k].d);
       if (cols[k].a >= 0) force_sum[static_cast<std::size_t>(cols[k].a)] += f * inv(cols[k].a);
       force_sum[static_cast<std::size_t>(cols[k].b)] += f * inv(cols[k].b);
     }
+  };
+  // out: each member's force acceleration plus its contact forces l over its mass.
+  const auto accelerations = [&](std::span<const double> l, std::vector<Vec2>& out) {
+    out.resize(M);
+    for (std::size_t q = 0; q < M; ++q) out[q] = w.acc[members[q]];
+    for (std::size_t k = 0; k < C; ++k) {
+      const Col& c = cols[k];
+      if (l[k] == 0.0) continue;
+      if (c.a >= 0) out[static_cast<std::size_t>(c.a)] -= (l[k] * inv(c.a)) * c.d;
+      out[static_cast<std::size_t>(c.b)] += (l[k] * inv(c.b)) * c.d;
+    }
+  };
+  const auto all_at_rest = [&](std::span<const Vec2> a, std::span<const double> l) {
+    sum_forces(l);
     for (std::size_t q = 0; q < M; ++q) {
       if (length(a[q]) > 1e-9 * length(w.acc[members[q]]) + 64.0 * 2.220446049250313e-16 * force_sum[q]) return false;
     }
@@ -1279,14 +1294,7 @@ Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint
       if (lam2[act[z]] < 0.0) nonneg = false;
     }
     if (nonneg) {
-      acc2.resize(M);
-      for (std::size_t q = 0; q < M; ++q) acc2[q] = w.acc[members[q]];
-      for (std::size_t k = 0; k < C; ++k) {
-        const Col& c = cols[k];
-        if (lam2[k] == 0.0) continue;
-        if (c.a >= 0) acc2[static_cast<std::size_t>(c.a)] -= (lam2[k] * inv(c.a)) * c.d;
-        acc2[static_cast<std::size_t>(c.b)] += (lam2[k] * inv(c.b)) * c.d;
-      }
+      accelerations(lam2, acc2);
       held = all_at_rest(acc2, lam2);
     }
   }
@@ -1313,12 +1321,7 @@ Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint
   // edge >= -64 eps x the largest force acceleration on a member counts as >= 0 there. (A
   // member is at rest within the round-off of its own forces, as above: stricter.)
   const auto verdict_of = [&](std::span<const Vec2> a, std::span<const double> l, bool exact) {
-    force_sum.assign(M, 0.0);
-    for (std::size_t k = 0; k < C; ++k) {
-      const double f = std::fabs(l[k]) * length(cols[k].d);
-      if (cols[k].a >= 0) force_sum[static_cast<std::size_t>(cols[k].a)] += f * inv(cols[k].a);
-      force_sum[static_cast<std::size_t>(cols[k].b)] += f * inv(cols[k].b);
-    }
+    sum_forces(l);
     const auto slack = [&](std::int32_t x) { return x < 0 ? 0.0 : 64.0 * 2.220446049250313e-16 * force_sum[static_cast<std::size_t>(x)]; };
     const auto rel = [&](const Col& c) {
       const Vec2 aa = c.a < 0 ? Vec2{} : a[static_cast<std::size_t>(c.a)];
@@ -1361,14 +1364,7 @@ Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint
   if (!exact_least_squares(w, members, C, [&](std::size_t k) { return std::tuple(cols[k].a, cols[k].b, cols[k].d); }, x)) {
     return Verdict::kUndecided;
   }
-  acc2.resize(M);
-  for (std::size_t q = 0; q < M; ++q) acc2[q] = w.acc[members[q]];
-  for (std::size_t k = 0; k < C; ++k) {
-    const Col& c = cols[k];
-    if (x[k] == 0.0) continue;
-    if (c.a >= 0) acc2[static_cast<std::size_t>(c.a)] -= (x[k] * inv(c.a)) * c.d;
-    acc2[static_cast<std::size_t>(c.b)] += (x[k] * inv(c.b)) * c.d;
-  }
+  accelerations(x, acc2);
   const Verdict ve = verdict_of(acc2, x, true);
   if (ve == Verdict::kCannotHold) {
     residual = 0.0;

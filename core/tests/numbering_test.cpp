@@ -69,17 +69,7 @@ Scene renumbered(const Scene& canonical, const Numbering& v) {
   Scene s = canonical;
   s.bodies.clear();
   for (std::size_t k : v.perm) s.bodies.push_back(canonical.bodies[k]);
-  if (v.mirror) {
-    for (BodyDef& b : s.bodies) {
-      b.position.x = -b.position.x;
-      b.velocity.x = -b.velocity.x;
-    }
-    for (WallDef& w : s.walls) {   // mirrored and drawn the other way: the same side faces the bodies
-      w.from.x = -w.from.x;
-      w.to.x = -w.to.x;
-      std::swap(w.from, w.to);
-    }
-  }
+  if (v.mirror) mirror_x(s);
   if (v.reverse_walls) std::reverse(s.walls.begin(), s.walls.end());
   return s;
 }
@@ -106,10 +96,7 @@ Trace run(const Scene& canonical, const Numbering& v, int n_steps) {
     std::vector<BodyState> c(n);
     for (std::size_t i = 0; i < n; ++i) {
       BodyState b = sim.states[i];
-      if (v.mirror) {
-        b.position.x = -b.position.x;
-        b.velocity.x = -b.velocity.x;
-      }
+      if (v.mirror) mirror_x(b);
       c[v.perm[i]] = b;
     }
     tr.steps.push_back(std::move(c));

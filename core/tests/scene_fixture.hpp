@@ -66,6 +66,24 @@ inline Scene scene_of(std::vector<BodyDef> bodies, std::vector<WallDef> walls = 
   return s;
 }
 
+// The scene's mirror image in x = 0 (bodies and walls; each wall drawn the other way, so
+// the same side faces the bodies), and a state mirrored back.
+inline void mirror_x(Scene& s) {
+  for (BodyDef& b : s.bodies) {
+    b.position.x = -b.position.x;
+    b.velocity.x = -b.velocity.x;
+  }
+  for (WallDef& w : s.walls) {
+    w.from.x = -w.from.x;
+    w.to.x = -w.to.x;
+    std::swap(w.from, w.to);
+  }
+}
+inline void mirror_x(BodyState& b) {
+  b.position.x = -b.position.x;
+  b.velocity.x = -b.velocity.x;
+}
+
 inline EngineOptions options(std::string integrator, std::string collision = "exact") {
   return {{"integrator", std::move(integrator)}, {"collision", std::move(collision)}};
 }

@@ -67,17 +67,7 @@ struct Variant {
 };
 
 Scene transformed(Scene s, const Variant& v) {
-  if (v.mirror) {
-    for (BodyDef& b : s.bodies) {
-      b.position.x = -b.position.x;
-      b.velocity.x = -b.velocity.x;
-    }
-    for (WallDef& w : s.walls) {   // mirrored and drawn the other way: the same side faces the bodies
-      w.from.x = -w.from.x;
-      w.to.x = -w.to.x;
-      std::swap(w.from, w.to);
-    }
-  }
+  if (v.mirror) mirror_x(s);
   if (v.reverse_bodies) std::reverse(s.bodies.begin(), s.bodies.end());
   if (v.reverse_walls) std::reverse(s.walls.begin(), s.walls.end());
   return s;
@@ -111,10 +101,7 @@ Trace run(const Scene& canonical, const Variant& v, int n_steps) {
     std::vector<BodyState> c(n);
     for (std::size_t i = 0; i < n; ++i) {
       BodyState b = sim.states[v.reverse_bodies ? n - 1 - i : i];
-      if (v.mirror) {
-        b.position.x = -b.position.x;
-        b.velocity.x = -b.velocity.x;
-      }
+      if (v.mirror) mirror_x(b);
       c[i] = b;
     }
     tr.steps.push_back(c);
