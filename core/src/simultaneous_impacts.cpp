@@ -171,9 +171,57 @@ bool eligible_body(const World& w, std::uint32_t i) {
   return (w.flags[i] & (kParticle | kPoint)) == 0;
 }
 
-// Does not move in this impact: static, or at rest on its supports in a slow impact.
-bool fixed(const World& w, std::uint32_t i, bool fixed_rest) {
-  return w.is_static(i) || (fixed_rest && w.stationary(i));
+// Does not move in this impact: static, or at rest on its supports in a slow impact
+// (except `yielding`, see lone_on_frictionless_faces).
+bool fixed(const World& w, std::uint32_t i, bool fixed_rest, std::uint32_t yielding) {
+  return w.is_static(i) || (fixed_rest && i != yielding && w.stationary(i));
+}
+
+// Body i, at rest on a face, whose faces are all frictionless and which touches no body
+// but `striker` at t: its supports absorb nothing along the faces, so a slow impact on it
+// is an ordinary two-body impact (momentum shared), not one on a fixed body. (A body at
+// rest among others, as in a pile, is left to the rule for bodies at rest: the impact
+// would pass through it into bodies that may hold it.)
+bool lone_on_frictionless_faces(World& w, std::uint32_t i, std::uint32_t striker, double t) {
+  if (!w.stationary(i) || w.is_static(i) || !w.supported(i) || w.on_body(i) || w.is_held(i)) return false;
+  if (w.statics.segments.empty()) return false;
+  const Vec2 p = pos_now(w, i, t);
+  const double pad = w.radius[i] * (1.0 + 1e-9) + kGapUlps * kEps * (inf_norm(p) + w.length_scale);
+  w.found_static.clear();
+  w.statics.query(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), w.found_static);
+  bool on_support = false;
+  for (std::uint32_t k : w.found_static) {
+    const Segment& s = w.statics.segments[k];
+    const double u = dot(p - s.from, s.dir);
+    const double D = dot(p - s.from, s.normal);
+    const double scale = inf_norm(p) + w.radius[i] + inf_norm(s.from) + inf_norm(s.to);
+    if (u < -w.radius[i] || u > s.length + w.radius[i]) continue;
+    if (std::fabs(D) - w.radius[i] > kGapUlps * kEps * scale) continue;
+    const PairMaterial m = w.pair_material(w.material[i], s.material);
+    if (m.friction > 0.0 || m.static_friction > 0.0) return false;
+    if (s.normal_from.x != 0.0 || s.normal_from.y != 0.0) return false;
+    if (u < 0.0 || u > s.length) return false;   // on an end: not a plain face contact
+    if (on_support) return false;                 // two faces (a corner) can hold it
+    on_support = true;
+    // Struck square to the face, the face takes it all: met as before, exactly.
+    const Vec2 sp = pos_now(w, striker, t);
+    const double dl = length(sp - p);
+    if (!(dl > 0.0)) return false;
+    if (std::fabs(dot((sp - p) / dl, s.dir)) <= kGapUlps * kEps) return false;
+  }
+  if (!on_support) return false;
+  thread_local std::vector<std::uint32_t> near;
+  near.clear();
+  const double bpad = kGapUlps * kEps * (inf_norm(p) + 2.0 * w.radius[i] + 1.0) + w.radius[i];
+  w.bp->query_box(make_aabb(p.x - bpad, p.y - bpad, p.x + bpad, p.y + bpad), i, near);
+  for (std::uint32_t j : near) {
+    if (j == i || j == striker || !w.alive(j)) continue;
+    const Vec2 pj = pos_now(w, j, t);
+    const double R = w.radius[i] + w.radius[j];
+    const double scale = inf_norm(p) + inf_norm(pj) + R;
+    if (length(pj - p) - R <= kGapUlps * kEps * scale) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -198,7 +246,12 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     }
     fixed_rest = closing < w.collapse_speed(i0, face_seed ? i0 : j0);
   }
-  if (fixed(w, i0, fixed_rest) && (face_seed || fixed(w, j0, fixed_rest))) return false;
+  std::uint32_t yielding = kNone;
+  if (fixed_rest && !face_seed) {
+    if (!w.stationary(j0) && lone_on_frictionless_faces(w, i0, j0, t)) yielding = i0;
+    if (!w.stationary(i0) && lone_on_frictionless_faces(w, j0, i0, t)) yielding = j0;
+  }
+  if (fixed(w, i0, fixed_rest, yielding) && (face_seed || fixed(w, j0, fixed_rest, yielding))) return false;
   // Scratch kept between calls: an isolated impact (the common case) allocates nothing.
   thread_local std::vector<Contact> contacts;
   thread_local std::vector<std::uint32_t> found;
@@ -250,7 +303,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     Contact scratch;   // touching() and add() set every field they read
     const auto consider = [&](std::uint32_t i, std::uint32_t j) {
       if (j == i || !eligible(j)) return true;
-      if (fixed(w, i, fixed_rest) && fixed(w, j, fixed_rest)) return true;
+      if (fixed(w, i, fixed_rest, yielding) && fixed(w, j, fixed_rest, yielding)) return true;
       const std::uint32_t lo = std::min(i, j), hi = std::max(i, j);
       const bool known = std::any_of(contacts.begin(), contacts.end(),
                                      [&](const Contact& k) { return k.a == lo && k.b == hi; });
@@ -270,7 +323,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     // The faces body i touches; false if one has interpolated normals (a surface: its own
     // response).
     const auto consider_faces = [&](std::uint32_t i) {
-      if (w.statics.segments.empty() || fixed(w, i, fixed_rest)) return true;
+      if (w.statics.segments.empty() || fixed(w, i, fixed_rest, yielding)) return true;
       const Vec2 p = pos_now(w, i, t);
       const double pad = w.radius[i] * (1.0 + 1e-9) + kGapUlps * kEps * (inf_norm(p) + w.length_scale);
       w.found_static.clear();
@@ -303,7 +356,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     // struck at one end; as a leaf each was met pair by pair at one instant, a cycle that
     // ended in a hold the bodies could not justify: the frictionless pile of seed 2).
     const auto leaf = [&](std::uint32_t i) {
-      if (!w.supported(i) || fixed(w, i, fixed_rest)) return false;
+      if (!w.supported(i) || fixed(w, i, fixed_rest, yielding)) return false;
       if (w.on_body(i) || w.is_held(i)) return true;
       const PairMaterial m = w.pair_material(w.material[i], w.statics.segments[w.support[i]].material);
       return m.friction > 0.0 || m.static_friction > 0.0;
@@ -325,8 +378,8 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       // impact came back at the same instant until the event cap).
       if (!consider(first, second)) return false;
       for (std::uint32_t j : found) {
-        if (!fixed(w, first, fixed_rest) && !leaf(first) && !consider(first, j)) return false;
-        if (!fixed(w, second, fixed_rest) && !leaf(second) && !consider(second, j)) return false;
+        if (!fixed(w, first, fixed_rest, yielding) && !leaf(first) && !consider(first, j)) return false;
+        if (!fixed(w, second, fixed_rest, yielding) && !leaf(second) && !consider(second, j)) return false;
       }
       // One contact so far and no faces: an isolated impact, the pairwise law's.
       if (!consider_faces(first) || !consider_faces(second)) return false;
@@ -334,7 +387,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     }
     for (; q < bodies.size(); ++q) {
       const std::uint32_t i = bodies[q];
-      if (fixed(w, i, fixed_rest)) continue;
+      if (fixed(w, i, fixed_rest, yielding)) continue;
       if (leaf(i)) {
         if (!consider_faces(i)) return false;
         continue;
@@ -376,7 +429,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   w0.assign(R, 0.0);
   p.assign(R, 0.0);
   const auto inv = [&](std::uint32_t x) {
-    return (x & kSegmentContact) || fixed(w, x, fixed_rest) ? 0.0 : w.inv_mass[x];
+    return (x & kSegmentContact) || fixed(w, x, fixed_rest, yielding) ? 0.0 : w.inv_mass[x];
   };
   const auto vel = [&](std::uint32_t x) { return (x & kSegmentContact) ? Vec2{} : w.vel[x]; };
   // Each row reads and writes its bodies' velocity changes (dv), so a sweep costs O(R),

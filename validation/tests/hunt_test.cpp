@@ -279,10 +279,10 @@ TEST(Hunt, CoreMeetsTheCatchRowClosedForm) { expect_core_meets("catch_row.toml")
 // of the 24 body orders core ended with all four at rest (47.6 N s gone) or the front ball 9%
 // slow, `ok`: met pairwise, the 1000 kg ball reached the frictionless one below the collapse
 // speed and the slow impact met it, at rest, as fixed ("its supports absorb it"), though a
-// frictionless face absorbs nothing along it. Open (README, The hunt for wrong greens: the fix
-// tried broke the frictionless piles' numbering independence). Every order of the four bodies
-// must meet the closed form.
-TEST(Hunt, DISABLED_CoreMeetsTheFrictionlessLeaderClosedFormInEveryNumbering) {
+// frictionless face absorbs nothing along it. Fixed: a body at rest on one frictionless face,
+// touching no body but the striker, is not fixed in a slow impact (simultaneous_impacts.cpp,
+// lone_on_frictionless_faces). Every order of the four bodies must meet the closed form.
+TEST(Hunt, CoreMeetsTheFrictionlessLeaderClosedFormInEveryNumbering) {
   const EngineFactory* core = reference_engine();
   ASSERT_NE(core, nullptr);
   const ScenarioLoad l = load_scenario_file(std::string(PHYSVAL_SOURCE_DIR) +
@@ -306,9 +306,10 @@ TEST(Hunt, DISABLED_CoreMeetsTheFrictionlessLeaderClosedFormInEveryNumbering) {
   EXPECT_EQ(runs, 24);
 }
 
-// slow_strike_frictionless_at_rest (hunt4, open): the same cause alone: a ball at 0.01 m/s
-// strikes a frictionless ball at rest on the floor, which never moves (0.0167 m short at 2 s, `ok`).
-TEST(Hunt, DISABLED_CoreMeetsTheSlowStrikeOnAFrictionlessBallClosedForm) {
+// slow_strike_frictionless_at_rest (hunt4): the same cause alone: a ball at 0.01 m/s strikes a
+// frictionless ball at rest on the floor, which never moved (0.0167 m short at 2 s, `ok`). Fixed
+// as the one above: both leave at 10 0.01 / 11 m/s.
+TEST(Hunt, CoreMeetsTheSlowStrikeOnAFrictionlessBallClosedForm) {
   expect_core_meets("slow_strike_frictionless_at_rest.toml");
 }
 
