@@ -378,7 +378,9 @@ TEST(Gate, BaselineFailsWhenAMeasuredMetricIsNoLongerMeasured) {
   const auto& checks = result.scenarios[0].runs[0].checks;
   ASSERT_EQ(checks.size(), 2u);
   for (const Check& c : checks) {
-    if (c.what == "baseline.energy_drift") EXPECT_TRUE(c.pass);
+    if (c.what == "baseline.energy_drift") {
+      EXPECT_TRUE(c.pass);
+    }
     if (c.what == "baseline.position_divergence") {
       EXPECT_FALSE(c.pass);
       EXPECT_FALSE(c.value.has_value());
