@@ -206,6 +206,14 @@ final = [ {{ body = "a", velocity = [{v1!r}, 0.0], tolerance = {tol!r} }},
 # the tolerance core, the reference, must meet it to). Found by this grid: `edge`.
 truth = {}
 g = 9.8
+def materials(pairs):
+    """[[materials]] tables, one per (a, b, friction)."""
+    return "".join(f"""[[materials]]
+a = "{a}"
+b = "{b}"
+friction = {mu}
+""" for a, b, mu in pairs)
+
 def exact(name, text, pos, vel, tol, judge="core"):
     write(name, text)
     truth[name] = {"position": pos, "velocity": vel, "tol": tol, "judge": judge}
@@ -591,19 +599,7 @@ from = [-50.0, 0.0]
 to = [50.0, 0.0]
 restitution = 0.0
 friction = 1.0
-[[materials]]
-a = "back"
-b = "floor"
-friction = {mub}
-[[materials]]
-a = "front"
-b = "floor"
-friction = {muf}
-[[materials]]
-a = "back"
-b = "front"
-friction = 0.0
-""", [xb, 0.5], [vb, 0.0], 1e-8)
+""" + materials([("back", "floor", mub), ("front", "floor", muf), ("back", "front", 0.0)]), [xb, 0.5], [vb, 0.0], 1e-8)
                 truth[n]["front"] = {"position": [xf, 0.5], "velocity": [vf, 0.0]}
 
 # catch: on a 10-40 degree slope, a ball of friction mu_b starts 0.3 m behind one of mu_f >
@@ -642,19 +638,7 @@ from = [{-10 * t[0]!r}, {-10 * t[1]!r}]
 to = [{60 * t[0]!r}, {60 * t[1]!r}]
 restitution = 0.0
 friction = 1.0
-[[materials]]
-a = "back"
-b = "slope"
-friction = {mub}
-[[materials]]
-a = "front"
-b = "slope"
-friction = {muf}
-[[materials]]
-a = "back"
-b = "front"
-friction = 0.0
-""", at(sf - 1.0), [(v + 0.5 * a) * t[0], (v + 0.5 * a) * t[1]], 1e-8)
+""" + materials([("back", "slope", mub), ("front", "slope", muf), ("back", "front", 0.0)]), at(sf - 1.0), [(v + 0.5 * a) * t[0], (v + 0.5 * a) * t[1]], 1e-8)
                 truth[n]["front"] = {"position": at(sf), "velocity": [(v + 0.5 * a) * t[0], (v + 0.5 * a) * t[1]]}
 
 # catch (a row): the same with a ball catching two touching balls (frictions mu_m <= mu_f,
