@@ -96,10 +96,27 @@ bool placement_meets_barrier(const World& w, const std::vector<std::uint32_t>& s
 // at 500 m/s left a closed 4 m box in one 1/60 s step, and the run was `ok`): such a
 // particle starts at t_end from its emission point and velocity instead (late by at most
 // one step, a first-order error in its own path), and its impact comes in the next step.
-void spawn_from(World& w, const std::vector<std::uint32_t>& statics, EmitterState& e, std::uint16_t emitter, Vec2 p,
-                Vec2 v0, Vec2 g, double s, double birth) {
+// The scene's static bodies, listed on the first placement of a step that needs them
+// (most steps emit nothing and list nothing).
+struct StaticBodies {
+  std::vector<std::uint32_t> list;
+  bool listed = false;
+  const std::vector<std::uint32_t>& of(const World& w) {
+    if (!listed) {
+      list.clear();
+      for (std::uint32_t i = 0; i < w.scene_bodies; ++i) {
+        if (w.is_static(i)) list.push_back(i);
+      }
+      listed = true;
+    }
+    return list;
+  }
+};
+
+void spawn_from(World& w, StaticBodies& statics, EmitterState& e, std::uint16_t emitter, Vec2 p, Vec2 v0, Vec2 g,
+                double s, double birth) {
   thread_local std::vector<std::uint32_t> found;
-  if (placement_meets_barrier(w, statics, found, w.group[e.parent], p, v0, g, s)) {
+  if (placement_meets_barrier(w, statics.of(w), found, w.group[e.parent], p, v0, g, s)) {
     spawn(w, e, emitter, p, v0, birth);
   } else {
     spawn(w, e, emitter, p + s * v0 + (0.5 * s * s) * g, v0 + s * g, birth);
@@ -147,11 +164,8 @@ void record_emission(World& w, std::uint32_t emitter, Vec2 position, Vec2 veloci
 
 void finish_particles(World& w, const StepContext& ctx) {
   const double t_end = ctx.t0 + ctx.dt;
-  thread_local std::vector<std::uint32_t> statics;   // the static bodies, for spawn_from
-  statics.clear();
-  for (std::uint32_t i = 0; i < w.scene_bodies; ++i) {
-    if (w.is_static(i)) statics.push_back(i);
-  }
+  thread_local StaticBodies statics;   // for spawn_from
+  statics.listed = false;
   for (std::size_t k = 0; k < w.emitters.size(); ++k) {
     EmitterState& e = w.emitters[k];
     const auto id = static_cast<std::uint16_t>(k);
