@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -316,8 +317,126 @@ TEST(Hunt, CoreMeetsTheSlowStrikeOnAFrictionlessBallClosedForm) {
 // frictionless_into_row_at_wall (hunt4, open): a frictionless ball strikes (e 0) a ball at
 // rest against a wall; it must stop dead, core sends it back at half the rest speed (the
 // micro-bounce's minimum separation) and, frictionless, it slides away for ever (5 mm at 2 s).
-TEST(Hunt, DISABLED_CoreMeetsTheFrictionlessStrikerIntoARowAtAWallClosedForm) {
+TEST(Hunt, CoreMeetsTheFrictionlessStrikerIntoARowAtAWallClosedForm) {
   expect_core_meets("frictionless_into_row_at_wall.toml");
+}
+
+// The same scene over a grid: a frictionless striker (radius 0.05 m) at u meets a row of
+// 1-3 touching balls at rest on a floor, the last touching a wall, at t_hit (inside a
+// step). Closed form (Newton's law at every contact at once; core's collapse threshold: an
+// impact closing slower than v_r = g dt / 16 is perfectly inelastic): the row is backed by
+// the wall, so it never moves; the striker leaves at -e' u, e' = e (0 below v_r), and slides
+// back on the frictionless floor for ever. Speeds 0.01-2 m/s, striker:row masses 1:1,
+// 1:1000, 1000:1, e 0 and 0.5, dt 1/60 and 1/240, the row with friction 0.5 or none,
+// every numbering of the bodies (24 for a row of 3) and the mirror image.
+struct RowAtWall {
+  int n = 1;
+  double u = 1.0, m_striker = 1.0, m_row = 1.0, e = 0.0, dt = 1.0 / 60.0, row_mu = 0.5;
+  bool mirror = false;
+};
+
+Scene row_at_wall_scene(const RowAtWall& c, const std::vector<std::size_t>& order, double& t_hit) {
+  const double r = 0.05, x_wall = 0.5, sx = c.mirror ? -1.0 : 1.0;
+  Scene s;
+  s.name = "row_at_wall";
+  s.dt = c.dt;
+  s.duration = 2.0;
+  s.world.gravity = {0.0, -9.8};
+  t_hit = 0.5 + 0.37 * c.dt;
+  std::vector<BodyDef> listed;
+  const double x_first = x_wall - r - 2.0 * r * (c.n - 1);
+  BodyDef striker = circle("s", {sx * (x_first - 2.0 * r - c.u * t_hit), r}, r, c.m_striker);
+  striker.velocity = {sx * c.u, 0.0};
+  listed.push_back(striker);
+  for (int k = 0; k < c.n; ++k) {
+    listed.push_back(circle("b" + std::to_string(k), {sx * (x_first + 2.0 * r * k), r}, r, c.m_row));
+  }
+  for (BodyDef& b : listed) b.restitution = c.e;
+  s.bodies.clear();
+  for (std::size_t k : order) s.bodies.push_back(listed[k]);
+  WallDef floor;
+  floor.name = "floor";
+  floor.from = {-50.0, 0.0};
+  floor.to = {50.0, 0.0};
+  floor.material.restitution = c.e;
+  WallDef end;
+  end.name = "end";
+  end.from = {sx * x_wall, 0.0};
+  end.to = {sx * x_wall, 3.0 * r};
+  end.material.restitution = c.e;
+  s.walls = {floor, end};
+  for (const BodyDef& b : listed) {
+    const double mu = b.name == "s" ? 0.0 : c.row_mu;
+    for (const char* w : {"floor", "end"}) {
+      MaterialOverride m;
+      m.a = b.name;
+      m.b = w;
+      m.friction = mu;
+      m.static_friction = mu;
+      s.materials.push_back(m);
+    }
+  }
+  return s;
+}
+
+TEST(Hunt, CoreMeetsTheStrikerIntoARowAtAWallClosedFormOverAGrid) {
+  const EngineFactory* core = reference_engine();
+  ASSERT_NE(core, nullptr);
+  int runs = 0, bounced = 0, failures = 0;
+  for (int n : {1, 2, 3}) {
+    for (double u : {0.01, 0.05, 0.3, 2.0}) {
+      for (const auto& [ms, mr] : {std::pair{1.0, 1.0}, std::pair{1.0, 1000.0}, std::pair{1000.0, 1.0}}) {
+        for (double e : {0.0, 0.5}) {
+          for (double dt : {1.0 / 60.0, 1.0 / 240.0}) {
+            for (double row_mu : {0.5, 0.0}) {
+              for (bool mirror : {false, true}) {
+                RowAtWall c{n, u, ms, mr, e, dt, row_mu, mirror};
+                std::vector<std::size_t> order(static_cast<std::size_t>(n) + 1);
+                for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+                do {
+                  double t_hit = 0.0;
+                  const Scene scene = row_at_wall_scene(c, order, t_hit);
+                  const RunRecord rec = run_and_compare(scene, *core);
+                  std::string which = "n " + std::to_string(n) + " u " + std::to_string(u) + " m " +
+                                      std::to_string(ms) + ":" + std::to_string(mr) + " e " + std::to_string(e) +
+                                      " dt 1/" + std::to_string(std::lround(1.0 / dt)) + " row mu " +
+                                      std::to_string(row_mu) + (mirror ? " mirrored" : "") + " order";
+                  for (std::size_t k : order) which += " " + std::to_string(k);
+                  std::string wrong;
+                  if (rec.status != RunStatus::Ok) wrong += " status " + rec.reason;
+                  const double vr = 9.8 * dt / 16.0;
+                  const double e_eff = u < vr ? 0.0 : e;
+                  const double sx = mirror ? -1.0 : 1.0;
+                  for (std::size_t slot = 0; slot < order.size(); ++slot) {
+                    const BodyDef& b = scene.bodies[slot];
+                    const BodyState& f = rec.final_states[slot];
+                    Vec2 want_p = b.position, want_v{};
+                    if (b.name == "s") {
+                      const double x_hit = b.position.x + b.velocity.x * t_hit;
+                      want_v = {-sx * e_eff * u, 0.0};
+                      want_p = {x_hit + want_v.x * (scene.duration - t_hit), b.position.y};
+                    }
+                    const double off = std::max(length(f.position - want_p), length(f.velocity - want_v));
+                    if (!(off <= 1e-9)) {
+                      wrong += " " + b.name + " at (" + std::to_string(f.position.x) + ", " +
+                               std::to_string(f.position.y) + ") v (" + std::to_string(f.velocity.x) + ", " +
+                               std::to_string(f.velocity.y) + "), off " + std::to_string(off);
+                    }
+                  }
+                  if (!wrong.empty() && (++failures <= 30 || std::getenv("CW_ALL"))) ADD_FAILURE() << which << ":" << wrong;
+                  if (e_eff > 0.0) ++bounced;
+                  ++runs;
+                } while (std::next_permutation(order.begin(), order.end()));
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  EXPECT_EQ(failures, 0) << "of " << runs << " runs";
+  EXPECT_EQ(runs, 4 * 3 * 2 * 2 * 2 * 2 * (2 + 6 + 24));
+  EXPECT_GT(bounced, 0);
 }
 
 // pyramid_of_three: two balls on a frictionless floor and one on top: they must collapse
