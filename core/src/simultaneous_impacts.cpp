@@ -1335,7 +1335,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     const bool residual = (inf_norm(after) < std::numeric_limits<double>::min() &&
                            inf_norm(after) <= kGapUlps * kEps * inf_norm(before)) ||
                           inf_norm(after) <= 4.0 * kEps * inf_norm(before) ||
-                          inf_norm(after) <= kGapUlps * kEps * local;
+                          (friction && inf_norm(after) <= kGapUlps * kEps * local);
     w.vel[bodies[s]] = residual ? Vec2{} : after;
   }
   w.stats.impacts += static_cast<std::int64_t>(K) - 1;
