@@ -275,7 +275,7 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
         {"baseline", baseline_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(file_fingerprint(baseline_path))},
         {"baseline_factor", baseline.is_null() ? nlohmann::json(nullptr) : nlohmann::json(baseline_factor)}};
     shard_block = {{"index", shard->index},   {"count", shard->count},   {"command", gate ? "gate" : "run"},
-                   {"options", run_options}, {"scenarios", list}};
+                   {"options", run_options}, {"scenarios", list}, {"build", build_identity()}};
     std::cout << "shard " << shard->index << "/" << shard->count << ": " << mine.size() << " of " << scenes->size()
               << " scenarios (" << (total_cost > 0.0 ? static_cast<int>(100.0 * my_cost / total_cost + 0.5) : 0)
               << "% of the estimated cost)\n";
@@ -298,6 +298,10 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
   result.shard = shard_block;
   if (!baseline_path.empty()) {
     const int matched = apply_baseline(result, baseline, baseline_factor);
+    if (const int missing = add_runs_missing_from_baseline(result, baseline, o.engines); missing > 0) {
+      std::cout << "baseline: " << missing << " run(s) of the baseline not run now (an engine not loaded, or left out "
+                << "by a scenario's engines list): failed\n";
+    }
     std::cout << "baseline: " << matched << " runs matched in " << baseline_path << " (regression factor "
               << baseline_factor << ")\n";
     if (matched == 0) return bad_input(baseline_path + ": the baseline matches no run (scenario and engine): nothing compared");
@@ -623,6 +627,7 @@ int main(int argc, char** argv) {
       if (so.shard_count > 1) {
         // What the points depend on, for `physval merge` to compare the shards with.
         result.shard["command"] = "sweep";
+        result.shard["build"] = build_identity();
         result.shard["scenario"] = {{"name", load.scene->name}, {"file", file_fingerprint(sweep_scenario)}};
         result.shard["options"] = {{"dt", so.dts},
                                    {"engines", so.engines},

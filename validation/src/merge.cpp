@@ -37,6 +37,21 @@ json read_json(const fs::path& file) {
   }
 }
 
+// What differs between two shards' build blocks, in words.
+std::string build_difference(const json& a, const json& b) {
+  if (!a.is_object() || !b.is_object()) return "one was written by a physval that does not record its build";
+  if (a.value("executable", "") != b.value("executable", "")) return "another physval executable";
+  if (a.value("engines", json()) != b.value("engines", json())) {
+    auto list = [](const json& engines) {
+      std::string text;
+      for (const json& e : engines) text += (text.empty() ? "" : ", ") + e.value("name", "?") + " " + e.value("version", "?");
+      return text;
+    };
+    return "engines " + list(a.value("engines", json::array())) + " against " + list(b.value("engines", json::array()));
+  }
+  return "another plugin library";
+}
+
 struct Part {
   std::string dir;
   json doc;
@@ -80,11 +95,15 @@ std::vector<Part> read_parts(const std::vector<std::string>& dirs, const std::st
     }
     if (other != same) {
       std::string what = "options";
-      for (const char* key : {"command", "options", "scenarios", "scenario", "points"}) {
+      // The build first: another engine set also changes the split's costs.
+      for (const char* key : {"build", "command", "options", "scenarios", "scenario", "points"}) {
         if (other.value(key, json()) != same.value(key, json())) {
-          what = std::string(key) == "scenarios" || std::string(key) == "scenario"
-                     ? "scenario set (names or file contents)"
-                     : std::string(key) == "command" ? "command (run against gate)" : std::string(key);
+          const std::string k = key;
+          what = k == "scenarios" || k == "scenario" ? "scenario set (names or file contents)"
+                 : k == "command"                    ? "command (run against gate)"
+                 : k == "build" ? "build (physval executable, engines and their versions, or plugin libraries: " +
+                                      build_difference(other.value(key, json()), same.value(key, json())) + ")"
+                                : k;
           break;
         }
       }

@@ -8,6 +8,8 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
@@ -40,6 +42,86 @@ std::string hash_hex(const std::string& text) {
                 static_cast<unsigned long long>(h2));
   return buf;
 }
+
+std::string exact(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%a", v);
+  return buf;
+}
+
+json reference_to_json(const std::string& key, const Reference& ref) {
+  json j;
+  j["key"] = key;
+  j["available"] = ref.available;
+  j["converged"] = ref.converged;
+  j["reason"] = ref.reason;
+  j["dt"] = ref.dt;
+  j["convergence_error"] = ref.convergence_error;
+  j["seconds"] = ref.seconds;
+  j["run"] = ref.run ? json::binary(encode_run_record(*ref.run)) : json(nullptr);
+  return j;
+}
+
+// An entry's bytes: the CBOR document, then a newline and the hash of the document's
+// bytes (32 hex digits). A flipped byte anywhere (a damaged disk, a file edited or
+// overwritten in part) fails the hash, and the entry is recomputed: without it, a byte
+// changed inside the run's series still decoded, and the run was compared with another
+// reference than the one computed.
+constexpr std::size_t kSealSize = 1 + 32;
+
+std::string sealed(const std::vector<std::uint8_t>& cbor) {
+  std::string bytes(cbor.begin(), cbor.end());
+  const std::string seal = hash_file_bytes(bytes);
+  return bytes + '\n' + seal;
+}
+
+std::optional<Reference> reference_from(const std::string& entry, const std::string& key) {
+  if (entry.size() <= kSealSize || entry[entry.size() - kSealSize] != '\n') return std::nullopt;
+  const std::string bytes = entry.substr(0, entry.size() - kSealSize);
+  if (hash_file_bytes(bytes) != entry.substr(entry.size() - kSealSize + 1)) return std::nullopt;
+  try {
+    const json j = json::from_cbor(bytes);
+    if (j.at("key").get<std::string>() != key) return std::nullopt;
+    Reference ref;
+    ref.available = j.at("available").get<bool>();
+    ref.converged = j.at("converged").get<bool>();
+    ref.reason = j.at("reason").get<std::string>();
+    ref.dt = j.at("dt").get<double>();
+    ref.convergence_error = j.at("convergence_error").get<double>();
+    ref.seconds = j.at("seconds").get<double>();
+    if (!j.at("run").is_null()) ref.run = decode_run_record(j.at("run").get_binary());
+    return ref;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+void store(const std::filesystem::path& dir, const std::string& name, const std::string& key, const Reference& ref) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return;
+  static std::atomic<unsigned> counter{0};
+  std::ostringstream tmp_name;
+  tmp_name << ".tmp-" << ::getpid() << '-' << std::hash<std::thread::id>{}(std::this_thread::get_id()) << '-'
+           << counter.fetch_add(1) << '-' << name;
+  const std::filesystem::path tmp = dir / tmp_name.str();
+  const std::string bytes = sealed(json::to_cbor(reference_to_json(key, ref)));
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) return;
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    out.flush();
+    if (!out) {
+      out.close();
+      std::filesystem::remove(tmp, ec);
+      return;
+    }
+  }
+  std::filesystem::rename(tmp, dir / name, ec);   // atomic on one file system
+  if (ec) std::filesystem::remove(tmp, ec);
+}
+
+}  // namespace
 
 // Eight bytes at a time (two multiply-xorshift lanes): the executable is megabytes, and
 // byte-wise FNV under the sanitizers' instrumentation took ~25 s per physval process.
@@ -75,69 +157,16 @@ const std::string& executable_hash() {
   return hash;
 }
 
-std::string exact(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%a", v);
-  return buf;
-}
-
-json reference_to_json(const std::string& key, const Reference& ref) {
-  json j;
-  j["key"] = key;
-  j["available"] = ref.available;
-  j["converged"] = ref.converged;
-  j["reason"] = ref.reason;
-  j["dt"] = ref.dt;
-  j["convergence_error"] = ref.convergence_error;
-  j["seconds"] = ref.seconds;
-  j["run"] = ref.run ? json::binary(encode_run_record(*ref.run)) : json(nullptr);
-  return j;
-}
-
-std::optional<Reference> reference_from(const std::string& bytes, const std::string& key) {
-  try {
-    const json j = json::from_cbor(bytes);
-    if (j.at("key").get<std::string>() != key) return std::nullopt;
-    Reference ref;
-    ref.available = j.at("available").get<bool>();
-    ref.converged = j.at("converged").get<bool>();
-    ref.reason = j.at("reason").get<std::string>();
-    ref.dt = j.at("dt").get<double>();
-    ref.convergence_error = j.at("convergence_error").get<double>();
-    ref.seconds = j.at("seconds").get<double>();
-    if (!j.at("run").is_null()) ref.run = decode_run_record(j.at("run").get_binary());
-    return ref;
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-}
-
-void store(const std::filesystem::path& dir, const std::string& name, const std::string& key, const Reference& ref) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) return;
-  static std::atomic<unsigned> counter{0};
-  std::ostringstream tmp_name;
-  tmp_name << ".tmp-" << ::getpid() << '-' << std::hash<std::thread::id>{}(std::this_thread::get_id()) << '-'
-           << counter.fetch_add(1) << '-' << name;
-  const std::filesystem::path tmp = dir / tmp_name.str();
-  const std::vector<std::uint8_t> bytes = json::to_cbor(reference_to_json(key, ref));
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return;
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    out.flush();
-    if (!out) {
-      out.close();
-      std::filesystem::remove(tmp, ec);
-      return;
-    }
-  }
-  std::filesystem::rename(tmp, dir / name, ec);   // atomic on one file system
-  if (ec) std::filesystem::remove(tmp, ec);
-}
-
+namespace {
+std::mutex g_loaded_mutex;
+std::map<std::string, std::string> g_loaded_text_hash;   // scenario file -> hash of the text parsed
 }  // namespace
+
+void note_loaded_scenario_text(const std::string& file, const std::string& text) {
+  const std::string hash = hash_file_bytes(text);
+  const std::lock_guard<std::mutex> lock(g_loaded_mutex);
+  g_loaded_text_hash[file] = hash;
+}
 
 std::filesystem::path default_reference_cache_dir() {
   if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg == '/') {
@@ -151,6 +180,11 @@ std::string reference_cache_key(const Scene& scene, const RunOptions& options) {
   if (scene.source_file.empty()) return {};
   const std::string text = read_bytes(scene.source_file);
   if (text.empty()) return {};
+  {
+    const std::lock_guard<std::mutex> lock(g_loaded_mutex);
+    auto it = g_loaded_text_hash.find(scene.source_file);
+    if (it != g_loaded_text_hash.end() && it->second != hash_file_bytes(text)) return {};   // edited since loaded
+  }
   std::ostringstream key;
   key << "physval " << PHYSVAL_VERSION << " executable " << executable_hash() << '\n';
   if (const EngineFactory* engine = reference_engine()) {

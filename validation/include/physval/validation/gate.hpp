@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -19,5 +20,15 @@ std::string junit_xml(const SuiteResult& result);
 // the new value exceeds factor x the old one (plus `floor`, so values at round-off do
 // not trip it). Returns how many runs of the baseline were matched.
 int apply_baseline(SuiteResult& result, const nlohmann::json& baseline, double factor, double floor = 1e-12);
+
+// A baseline run (scenario S, engine E, not unsupported there) with no run of E on S now,
+// though S ran and E was not left out by `wanted` (--engines; empty: every engine): E is
+// not loaded in this physval (a CI artifact without the bundled plugins, a --plugin
+// dropped from the command) or S's own `engines` list no longer names it. Every
+// regression the baseline would catch on it is hidden, so such a run is added as
+// `unsupported` with a failing check `baseline.status` (JUnit: a failure). Returns how
+// many were added.
+int add_runs_missing_from_baseline(SuiteResult& result, const nlohmann::json& baseline,
+                                   const std::vector<std::string>& wanted);
 
 }  // namespace physval

@@ -1,0 +1,208 @@
+// The infrastructure hunt: ways to make physval green when something went wrong outside
+// the physics (merge, shards, the reference cache, the baseline). Each test failed before
+// its fix (README, "The infrastructure hunt").
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include <nlohmann/json.hpp>
+
+#include "physval/validation/reference_cache.hpp"
+#include "physval/validation/run_record_io.hpp"
+#include "physval/validation/scenario_loader.hpp"
+#include "physval_command.hpp"
+
+namespace physval {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using physval_test::physval;
+
+std::string read(const fs::path& f) {
+  std::ifstream in(f, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void put(const fs::path& f, const std::string& text) {
+  fs::create_directories(f.parent_path());
+  std::ofstream(f, std::ios::binary) << text;
+}
+
+// Two balls on a line, b at rest 1 m to the right of a; `velocity` is a's (negative: away
+// from b, which then stays where it is, as the expectation says).
+std::string pair_scene(const std::string& name, const std::string& velocity, const std::string& tail = "") {
+  return "name = \"" + name + "\"\nduration = 1.0\ndt = 0.01\n"
+         "[[bodies]]\nname = \"a\"\nradius = 0.1\nmass = 1\nposition = [0, 0]\nvelocity = [" + velocity + ", 0]\n"
+         "[[bodies]]\nname = \"b\"\nradius = 0.1\nmass = 2\nposition = [1, 0]\n"
+         "[expect]\nfinal = [ { body = \"b\", position = [1.0, 0.0] } ]\n" + tail;
+}
+
+class InfraHunt : public physval_test::TempDirTest {
+ protected:
+  InfraHunt() : TempDirTest("physval-infrahunt-") {}
+  std::string dir(const std::string& name) const { return (dir_ / name).string(); }
+};
+
+// --- merge: shards of another build -------------------------------------------------
+
+// A shard folder written by another physval executable (a folder left from an earlier
+// build whose task died this time, a node with an older install) merged: the version
+// number is the same across rebuilds, and merge compared nothing else of the build.
+TEST_F(InfraHunt, MergeRefusesAShardWrittenByAnotherPhysvalExecutable) {
+  put(dir_ / "suite" / "one.toml", pair_scene("one", "-1"));
+  put(dir_ / "suite" / "two.toml", pair_scene("two", "-2"));
+  const std::string common = " " + dir("suite") + " --engines core --quiet -j 1 --no-cache";
+  // The same program, other bytes: the copy runs exactly as the original.
+  const fs::path other = dir_ / "physval-other";
+  fs::copy_file(PHYSVAL_EXE, other);
+  { std::ofstream(other, std::ios::binary | std::ios::app) << "rebuilt"; }
+  fs::permissions(other, fs::perms::owner_all);
+  const auto s0 = physval("gate" + common + " --shard 0/2 --out " + dir("s0"));
+  ASSERT_NE(s0.status, 2) << s0.output;
+  const std::string cmd = other.string() + " gate" + common + " --shard 1/2 --out " + dir("s1") + " > /dev/null 2>&1";
+  const int w = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(w) && WEXITSTATUS(w) != 2);
+  const auto merged = physval("merge " + dir("s0") + " " + dir("s1") + " --out " + dir("m"));
+  EXPECT_EQ(merged.status, 2) << merged.output;
+  EXPECT_NE(merged.output.find("another physval executable"), std::string::npos) << merged.output;
+  EXPECT_FALSE(fs::exists(dir_ / "m"));
+  // Both shards from one executable still merge, to the single run's status.
+  ASSERT_NE(physval("gate" + common + " --shard 1/2 --out " + dir("s1b")).status, 2);
+  EXPECT_EQ(physval("merge " + dir("s0") + " " + dir("s1b") + " --out " + dir("m")).status, 0);
+  const json shard = json::parse(read(dir_ / "s0" / "results.json"))["shard"];
+  ASSERT_TRUE(shard.contains("build"));
+  EXPECT_EQ(shard["build"]["engines"][0]["name"], "core");
+}
+
+// --- the reference cache ---------------------------------------------------------------
+
+class InfraHuntCache : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = fs::temp_directory_path() / ("physval-infrahunt-cache-" + std::to_string(::getpid()) + "-" +
+                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(root_);
+    fs::create_directories(root_);
+    options_.reference_cache = (root_ / "cache").string();
+  }
+  void TearDown() override { fs::remove_all(root_); }
+  Scene load(const fs::path& file) {
+    ScenarioLoad l = load_scenario_file(file);
+    if (!l.scene) throw std::runtime_error("test scene does not load");
+    return *l.scene;
+  }
+  fs::path entry() const {
+    if (!fs::is_directory(root_ / "cache")) return {};
+    for (const auto& e : fs::directory_iterator(root_ / "cache")) {
+      if (e.path().extension() == ".ref") return e.path();
+    }
+    return {};
+  }
+  fs::path root_;
+  RunOptions options_;
+};
+
+std::vector<std::uint8_t> run_bytes(const Reference& r) { return r.run ? encode_run_record(*r.run) : std::vector<std::uint8_t>{}; }
+
+// A byte changed inside a cache entry (a damaged disk, a file overwritten in part) still
+// decoded when it fell inside the run's series: the key matched, and the scenario was
+// compared with a reference nobody computed. Every entry now carries a hash of its bytes.
+TEST_F(InfraHuntCache, AnEntryDamagedAnywhereIsRecomputedNeverServed) {
+  const fs::path file = root_ / "pair.toml";
+  put(file, pair_scene("pair", "2"));
+  const Scene scene = load(file);
+  const CachedReference first = cached_reference(scene, options_);
+  ASSERT_TRUE(first.reference.available) << first.reference.reason;
+  const std::vector<std::uint8_t> truth = run_bytes(first.reference);
+  const fs::path e = entry();
+  ASSERT_FALSE(e.empty());
+  const std::string good = read(e);
+  ASSERT_GT(good.size(), 1000u);
+  int served_wrong = 0, positions = 0;
+  for (std::size_t at = 3; at < good.size(); at += good.size() / 97 + 1) {
+    std::string bad = good;
+    bad[at] = static_cast<char>(bad[at] ^ 0x10);
+    put(e, bad);
+    const CachedReference again = cached_reference(scene, options_);
+    ++positions;
+    if (again.from_cache && (run_bytes(again.reference) != truth || again.reference.dt != first.reference.dt ||
+                             again.reference.convergence_error != first.reference.convergence_error)) {
+      ++served_wrong;
+    }
+    if (again.from_cache) EXPECT_EQ(run_bytes(again.reference), truth) << "byte " << at;
+  }
+  EXPECT_GT(positions, 90);
+  EXPECT_EQ(served_wrong, 0);
+  // A truncated entry likewise.
+  put(e, good.substr(0, good.size() / 2));
+  EXPECT_FALSE(cached_reference(scene, options_).from_cache);
+  // And the whole entry is read back.
+  put(e, good);
+  EXPECT_TRUE(cached_reference(scene, options_).from_cache);
+}
+
+// A scenario file edited while physval ran (between loading it and keying its reference)
+// had the reference of the scene as loaded stored under the *edited* text: the next run
+// of the edited file read it back, and was compared with another scene's reference.
+TEST_F(InfraHuntCache, AFileEditedDuringTheRunNeitherStoresNorServesAStaleReference) {
+  const fs::path file = root_ / "pair.toml";
+  put(file, pair_scene("pair", "2"));
+  const Scene loaded = load(file);
+  put(file, pair_scene("pair", "-3"));   // edited after loading, before the reference
+  const CachedReference during = cached_reference(loaded, options_);
+  ASSERT_TRUE(during.reference.available);
+  EXPECT_FALSE(during.from_cache);
+  EXPECT_TRUE(entry().empty()) << "a reference stored under text it was not computed from";
+  // The next run, of the file as it is now, computes its own reference.
+  const Scene edited = load(file);
+  const CachedReference next = cached_reference(edited, options_);
+  EXPECT_FALSE(next.from_cache);
+  ASSERT_TRUE(next.reference.run && during.reference.run);
+  const double x_next = next.reference.run->final_states.at(0).position.x;
+  const double x_during = during.reference.run->final_states.at(0).position.x;
+  EXPECT_NEAR(x_next, -3.0, 1e-9);   // a at -3 m/s meets nothing: x = -3 t
+  EXPECT_GT(x_during, -0.5);         // a at 2 m/s towards b
+  EXPECT_TRUE(cached_reference(edited, options_).from_cache);   // and is cached as usual
+}
+
+// --- the baseline: an engine it ran is gone ----------------------------------------
+
+// A baseline run on an engine that this physval no longer has (a CI artifact without the
+// bundled plugins, a --plugin dropped from the command) or that the scenario's engines
+// list now leaves out simply vanished: fewer runs, all passing, exit 0.
+TEST_F(InfraHunt, ABaselineRunOfAnEngineNoLongerRunFailsTheGate) {
+  put(dir_ / "suite" / "one.toml", pair_scene("one", "-1"));
+  const std::string common = " " + dir("suite") + " --quiet -j 1 --no-cache";
+  ASSERT_EQ(physval("gate" + common + " --engines core,box2d --out " + dir("base")).status, 0);
+  // The baseline as a physval with a plugin engine "retired" (since removed) wrote it.
+  json base = json::parse(read(dir_ / "base" / "results.json"));
+  json plugin_run = base["runs"][0];
+  ASSERT_EQ(plugin_run["engine"], "core");
+  plugin_run["engine"] = "retired";
+  base["runs"].push_back(plugin_run);
+  put(dir_ / "base" / "results.json", base.dump(2));
+  const auto gone = physval("gate" + common + " --engines core,box2d --baseline " + dir("base") + "/results.json --out " +
+                            dir("o1") + " --junit " + dir("o1.xml"));
+  // --engines names what is wanted; "retired" is not among them: left out on purpose.
+  EXPECT_EQ(gone.status, 0) << gone.output;
+  const auto all = physval("gate" + common + " --baseline " + dir("base") + "/results.json --out " + dir("o2") +
+                           " --junit " + dir("o2.xml"));
+  EXPECT_EQ(all.status, 1) << all.output;
+  const std::string xml = read(dir_ / "o2.xml");
+  EXPECT_NE(xml.find("name=\"retired\""), std::string::npos) << xml;
+  EXPECT_NE(xml.find("no engine named retired is loaded"), std::string::npos) << xml;
+  // The scenario's own engines list leaving box2d out fails too.
+  put(dir_ / "suite" / "one.toml", "engines = [\"core\"]\n" + pair_scene("one", "-1"));
+  const auto narrowed = physval("gate" + common + " --engines core,box2d --baseline " + dir("base") + "/results.json --out " +
+                                dir("o3"));
+  EXPECT_EQ(narrowed.status, 1) << narrowed.output;
+  EXPECT_NE(narrowed.output.find("not run now"), std::string::npos) << narrowed.output;
+}
+
+}  // namespace
+}  // namespace physval
