@@ -189,6 +189,7 @@ void record_known_failures(const SuiteResult& result, double margin) {
 
 int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, const std::string& baseline_path,
                 double baseline_factor, bool report, double record_known = 0.0) {
+  discard_earlier_junit(junit);   // a run that stops before writing it leaves none, not the last one
   RunOptions options;
   if (!o.dt.empty()) {
     options.dt = parse_seconds(o.dt);
@@ -655,6 +656,12 @@ int main(int argc, char** argv) {
       }
       std::cout << "sweep: " << (std::filesystem::path(sweep_out) / "sweep.csv").string() << ", sweep.json, "
                 << "speed_vs_error.png, error_vs_dt.png in " << sweep_out << '\n';
+      if (so.shard_count <= 1) {   // a shard's points may all fail; merge decides for the whole sweep
+        if (const std::string nothing = sweep_measured_nothing(result); !nothing.empty()) {
+          std::cerr << "physval: sweep measured nothing: " << nothing << '\n';
+          return kExitFailed;
+        }
+      }
       return 0;
     }
   } catch (const std::exception& e) {

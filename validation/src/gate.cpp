@@ -68,6 +68,15 @@ std::vector<std::string> failed_checks(const RunRecord& r) {
 
 }  // namespace
 
+void discard_earlier_junit(const std::string& file) {
+  if (file.empty()) return;
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(std::filesystem::symlink_status(file, ec)) ||
+      std::filesystem::is_symlink(std::filesystem::symlink_status(file, ec))) {
+    std::filesystem::remove(file, ec);
+  }
+}
+
 std::string junit_xml(const SuiteResult& result) {
   int tests = 0, failures = 0, errors = 0, skipped = 0;
   double total_time = 0.0;

@@ -254,6 +254,10 @@ int merge_sweep(const MergeOptions& options, std::ostream& out, std::ostream& er
   }
   out << "sweep: " << (fs::path(out_dir) / "sweep.csv").string() << ", sweep.json, speed_vs_error.png, error_vs_dt.png in "
       << out_dir << '\n';
+  if (const std::string nothing = sweep_measured_nothing(result); !nothing.empty()) {
+    err << "physval: sweep measured nothing: " << nothing << '\n';
+    return 1;
+  }
   return 0;
 }
 
@@ -298,6 +302,7 @@ SuiteResult suite_from_json(const json& results) {
 }
 
 int merge_shards(const MergeOptions& options, std::ostream& out, std::ostream& err) {
+  discard_earlier_junit(options.junit);   // a refused merge leaves no JUnit file, not the last one
   try {
     if (options.dirs.empty()) throw Refused("merge: no folders given");
     bool suite = false, sweep = false;

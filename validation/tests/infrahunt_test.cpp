@@ -204,5 +204,58 @@ TEST_F(InfraHunt, ABaselineRunOfAnEngineNoLongerRunFailsTheGate) {
   EXPECT_NE(narrowed.output.find("not run now"), std::string::npos) << narrowed.output;
 }
 
+// --- sweep: nothing measured -------------------------------------------------------
+
+// A sweep whose every point diverged (or crashed) printed a table of statuses, wrote its
+// files and exited 0, as a sweep that measured its figures does; merged shards likewise.
+TEST_F(InfraHunt, ASweepWhosePointsAllDivergedExitsOne) {
+  // The energy of 1e300 kg at 1e10 m/s is not finite: every engine diverges at once.
+  put(dir_ / "inf.toml", "name = \"inf\"\nduration = 0.1\ndt = 0.01\n[[bodies]]\nname = \"a\"\nradius = 0.1\n"
+                         "mass = 1e300\nposition = [0, 0]\nvelocity = [1e10, 0]\n");
+  const std::string common = " " + dir("inf.toml") + " --engines core,box2d --dt 1/100,1/200 --no-cache -j 1 --quiet";
+  const auto one = physval("sweep" + common + " --out " + dir("sw"));
+  EXPECT_EQ(one.status, 1) << one.output;
+  EXPECT_NE(one.output.find("sweep measured nothing: every point diverged or failed"), std::string::npos) << one.output;
+  EXPECT_TRUE(fs::exists(dir_ / "sw" / "sweep.json"));   // the statuses are still written
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(physval("sweep" + common + " --shard " + std::to_string(i) + "/2 --out " + dir("s" + std::to_string(i))).status, 0);
+  }
+  EXPECT_EQ(physval("merge " + dir("s0") + " " + dir("s1") + " --out " + dir("m")).status, 1);
+  // A sweep with points that ran is still a success.
+  put(dir_ / "fine.toml", pair_scene("fine", "-1"));
+  EXPECT_EQ(physval("sweep " + dir("fine.toml") + " --engines core --dt 1/100,1/200 --no-cache -j 1 --quiet --repetitions 1 --out " +
+                    dir("ok")).status, 0);
+}
+
+// --- JUnit: the last run's file ---------------------------------------------------------
+
+// A gate that stopped before writing its JUnit file (bad input, killed by a CI timeout)
+// left the previous run's file in place: a CI step that publishes it read the earlier
+// verdict (all passed) as this run's.
+TEST_F(InfraHunt, AGateThatWritesNoJunitLeavesNoEarlierJunit) {
+  put(dir_ / "suite" / "one.toml", pair_scene("one", "-1"));
+  const std::string junit = dir("junit.xml");
+  ASSERT_EQ(physval("gate " + dir("suite") + " --engines core --no-cache -j 1 --quiet --out " + dir("o") + " --junit " + junit).status, 0);
+  ASSERT_TRUE(fs::exists(junit));
+  // Bad input now (a typo in the file): exit 2, nothing run, and no JUnit file.
+  put(dir_ / "suite" / "one.toml", pair_scene("one", "-1") + "[gaet]\n");
+  EXPECT_EQ(physval("gate " + dir("suite") + " --engines core --no-cache -j 1 --quiet --out " + dir("o") + " --junit " + junit).status, 2);
+  EXPECT_FALSE(fs::exists(junit)) << "the earlier run's JUnit file is still there";
+  // Killed mid-run (SIGKILL, as a CI timeout or the OOM killer does): no JUnit file either.
+  put(dir_ / "suite" / "one.toml", pair_scene("one", "-1"));
+  ASSERT_EQ(physval("gate " + dir("suite") + " --engines core --no-cache -j 1 --quiet --out " + dir("o") + " --junit " + junit).status, 0);
+  put(dir_ / "suite" / "slow.toml", "name = \"slow\"\nduration = 1000.0\ndt = 1e-5\n[[bodies]]\nname = \"a\"\nradius = 0.1\n"
+                                    "mass = 1\nposition = [0, 0]\nvelocity = [1, 0]\n[gate]\nenergy_drift = 1\n");
+  const std::string cmd = "timeout -s KILL 1 " + std::string(PHYSVAL_EXE) + " gate " + dir("suite") +
+                          " --engines core --no-cache -j 1 --quiet --out " + dir("o") + " --junit " + junit + " > /dev/null 2>&1";
+  const int w = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(w) && WEXITSTATUS(w) == 137) << w;   // killed, as intended
+  EXPECT_FALSE(fs::exists(junit)) << "the earlier run's JUnit file survived a killed run";
+  // A refused merge leaves none either.
+  put(junit, "<testsuites/>\n");
+  EXPECT_EQ(physval("merge " + dir("o") + " --out " + dir("m") + " --junit " + junit).status, 2);
+  EXPECT_FALSE(fs::exists(junit));
+}
+
 }  // namespace
 }  // namespace physval

@@ -12,6 +12,12 @@
 
 namespace physval {
 
+// Removes a --junit FILE left by an earlier run, before anything else is done: a run that
+// then stops (bad input, exit 2; killed by a CI timeout or an OOM; results that cannot be
+// written) leaves no JUnit file, instead of the earlier run's, which a CI step publishing
+// the file would read as this run's verdict (all passed). Only a regular file is removed.
+void discard_earlier_junit(const std::string& file);
+
 // One <testcase> per scenario and engine; unsupported runs are <skipped/>.
 std::string junit_xml(const SuiteResult& result);
 
