@@ -117,6 +117,33 @@ void refresh_metas(const Engine& engine, std::vector<BodyMeta>& metas) {
   for (std::size_t i = metas.size(); i < n; ++i) metas.push_back(engine.body_meta(i));
 }
 
+// The scene's bodies as the engine reports them must be the scene's: the energy, the
+// momenta and containment are computed from the reported mass, radius and static flag.
+// An engine (a plugin) that reported its bodies massless or static had an energy and a
+// momentum of 0 at every sample, so every drift limit passed whatever it did. Masses
+// and radii are held to float32's round-off (Box2D derives mass from a density).
+void check_scene_bodies(const Scene& scene, const std::vector<BodyMeta>& metas, const std::string& engine) {
+  auto close = [](double a, double b) { return std::abs(a - b) <= 1e-5 * std::max(std::abs(a), std::abs(b)) + 1e-12; };
+  for (std::size_t i = 0; i < scene.bodies.size() && i < metas.size(); ++i) {
+    const BodyDef& want = scene.bodies[i];
+    const BodyMeta& got = metas[i];
+    std::string wrong;
+    if (got.name != want.name) {
+      wrong = "is named \"" + got.name + "\"";
+    } else if (got.is_static != want.is_static) {
+      wrong = got.is_static ? "is static" : "is not static";
+    } else if (!want.is_static && !close(got.mass, want.mass)) {
+      wrong = "has a mass of " + std::to_string(got.mass) + " kg (the scene's: " + std::to_string(want.mass) + " kg)";
+    } else if (!close(got.radius, want.radius)) {
+      wrong = "has a radius of " + std::to_string(got.radius) + " m (the scene's: " + std::to_string(want.radius) + " m)";
+    }
+    if (!wrong.empty()) {
+      throw std::runtime_error(engine + " reports the scene's body " + std::to_string(i) + " (\"" + want.name + "\") as one that " +
+                               wrong + ": its energy and momenta would not be the scene's");
+    }
+  }
+}
+
 bool states_finite(const std::vector<BodyState>& states) {
   for (const BodyState& s : states) {
     if (!s.alive) continue;
@@ -167,6 +194,7 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     r.load_seconds = std::chrono::duration<double>(clock::now() - t_load).count();
     r.settings = engine->settings();
     refresh_metas(*engine, r.bodies);
+    check_scene_bodies(scene, r.bodies, factory.info.name);
 
     // Probes: every step, for the bodies the expectations name.
     std::vector<ProbeTracker> trackers;

@@ -11,7 +11,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "physval/adapters/registry.hpp"
+#include "physval/validation/comparator.hpp"
 #include "physval/validation/reference_cache.hpp"
+#include "physval/validation/runner.hpp"
 #include "physval/validation/run_record_io.hpp"
 #include "physval/validation/scenario_loader.hpp"
 #include "physval_command.hpp"
@@ -255,6 +258,75 @@ TEST_F(InfraHunt, AGateThatWritesNoJunitLeavesNoEarlierJunit) {
   put(junit, "<testsuites/>\n");
   EXPECT_EQ(physval("merge " + dir("o") + " --out " + dir("m") + " --junit " + junit).status, 2);
   EXPECT_FALSE(fs::exists(junit));
+}
+
+// --- an engine that misreports the scene's bodies ---------------------------------------
+
+// core, with the scene's bodies reported through `lie` (a plugin's body_meta is its own
+// word): its motion is core's, only what it says about the bodies differs.
+class MisreportingEngine : public Engine {
+ public:
+  explicit MisreportingEngine(std::function<void(BodyMeta&)> lie) : inner_(find_engine("core")->create()), lie_(std::move(lie)) {}
+  const EngineInfo& info() const override { return inner_->info(); }
+  void load(const Scene& scene) override { inner_->load(scene); }
+  void step(double dt) override {
+    inner_->step(dt);
+    slowed_ *= 0.99;   // and it loses energy: every body's reported speed drops 1% a step
+  }
+  double time() const override { return inner_->time(); }
+  std::size_t body_count() const override { return inner_->body_count(); }
+  BodyMeta body_meta(std::size_t i) const override {
+    BodyMeta m = inner_->body_meta(i);
+    lie_(m);
+    return m;
+  }
+  void read_states(std::vector<BodyState>& out) const override {
+    inner_->read_states(out);
+    for (BodyState& b : out) b.velocity = slowed_ * b.velocity;
+  }
+  const std::vector<ContactEvent>& contacts() const override { return inner_->contacts(); }
+  std::vector<Setting> settings() const override { return inner_->settings(); }
+
+ private:
+  std::unique_ptr<Engine> inner_;
+  std::function<void(BodyMeta&)> lie_;
+  double slowed_ = 1.0;
+};
+
+// An engine that reported its bodies massless (or static) had an energy and momentum of 0
+// at every sample: energy_drift and linear_momentum_drift read 0 whatever it did, and a
+// gate on them passed an engine that lost 63% of its speed.
+TEST_F(InfraHunt, AnEngineThatMisreportsTheScenesBodiesIsAnError) {
+  put(dir_ / "free.toml", "name = \"free\"\nduration = 1.0\ndt = 0.01\n[[bodies]]\nname = \"a\"\nradius = 0.1\nmass = 2\n"
+                          "position = [0, 0]\nvelocity = [1, 0]\n[gate]\nenergy_drift = 1e-9\nlinear_momentum_drift = 1e-9\n");
+  ScenarioLoad load = load_scenario_file(dir_ / "free.toml");
+  ASSERT_TRUE(load.scene);
+  const Scene scene = *load.scene;
+  RunOptions options;
+  options.isolate = false;
+  const Reference reference = make_reference(scene, options);
+  ASSERT_TRUE(reference.available);
+  auto run_with = [&](std::function<void(BodyMeta&)> lie) {
+    EngineFactory f;
+    f.info = find_engine("core")->info;
+    f.info.name = "liar";
+    f.create = [lie] { return std::make_unique<MisreportingEngine>(lie); };
+    RunRecord r = run_engine(scene, f, options);
+    if (r.status == RunStatus::Ok) compare_run(r, scene, reference, true);
+    return r;
+  };
+  // Honest about its bodies, it fails its drift limits (it loses energy).
+  const RunRecord honest = run_with([](BodyMeta&) {});
+  EXPECT_EQ(honest.status, RunStatus::Ok) << honest.reason;
+  EXPECT_FALSE(honest.passed());
+  for (auto lie : std::vector<std::function<void(BodyMeta&)>>{
+           [](BodyMeta& m) { m.mass = 0.0; }, [](BodyMeta& m) { m.is_static = true; m.mass = 0.0; },
+           [](BodyMeta& m) { m.mass *= 1e-3; }, [](BodyMeta& m) { m.radius = 0.0; }, [](BodyMeta& m) { m.name = "b"; }}) {
+    const RunRecord r = run_with(lie);
+    EXPECT_EQ(r.status, RunStatus::Error) << r.reason;
+    EXPECT_FALSE(r.passed());
+    EXPECT_NE(r.reason.find("reports the scene's body 0 (\"a\")"), std::string::npos) << r.reason;
+  }
 }
 
 }  // namespace
