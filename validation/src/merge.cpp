@@ -165,6 +165,12 @@ int merge_suite(const MergeOptions& options, std::ostream& out, std::ostream& er
       if (i == index && !references.count(scenario)) {
         throw Refused(p.dir + ": scenario " + scenario + " of shard " + std::to_string(index) + " is missing from it");
       }
+      // Every scenario's series folder holds its scene.json: without it the folder was
+      // copied in part (an artifact upload cut short), and the merge would lack its series.
+      if (i == index && !fs::exists(fs::path(p.dir) / "series" / scenario / "scene.json")) {
+        throw Refused(p.dir + ": the series of scenario " + scenario + " are missing (series/" + scenario +
+                      "/scene.json): the folder is not a whole shard output");
+      }
     }
   }
 

@@ -55,7 +55,8 @@ class InfraHunt : public physval_test::TempDirTest {
 
 // A shard folder written by another physval executable (a folder left from an earlier
 // build whose task died this time, a node with an older install) merged: the version
-// number is the same across rebuilds, and merge compared nothing else of the build.
+// number is the same across rebuilds, and merge compared nothing else of the build. And
+// a shard folder without its series merged, into a folder lacking them.
 TEST_F(InfraHunt, MergeRefusesAShardWrittenByAnotherPhysvalExecutable) {
   put(dir_ / "suite" / "one.toml", pair_scene("one", "-1"));
   put(dir_ / "suite" / "two.toml", pair_scene("two", "-2"));
@@ -77,6 +78,13 @@ TEST_F(InfraHunt, MergeRefusesAShardWrittenByAnotherPhysvalExecutable) {
   // Both shards from one executable still merge, to the single run's status.
   ASSERT_NE(physval("gate" + common + " --shard 1/2 --out " + dir("s1b")).status, 2);
   EXPECT_EQ(physval("merge " + dir("s0") + " " + dir("s1b") + " --out " + dir("m")).status, 0);
+  // A shard folder copied in part (its series missing) is not a whole shard output.
+  fs::copy(dir_ / "s1b", dir_ / "s1c", fs::copy_options::recursive);
+  fs::remove_all(dir_ / "s1c" / "series");
+  const auto partial = physval("merge " + dir("s0") + " " + dir("s1c") + " --out " + dir("m2"));
+  EXPECT_EQ(partial.status, 2) << partial.output;
+  EXPECT_NE(partial.output.find("are missing"), std::string::npos) << partial.output;
+  EXPECT_FALSE(fs::exists(dir_ / "m2"));
   const json shard = json::parse(read(dir_ / "s0" / "results.json"))["shard"];
   ASSERT_TRUE(shard.contains("build"));
   EXPECT_EQ(shard["build"]["engines"][0]["name"], "core");
@@ -137,7 +145,9 @@ TEST_F(InfraHuntCache, AnEntryDamagedAnywhereIsRecomputedNeverServed) {
                              again.reference.convergence_error != first.reference.convergence_error)) {
       ++served_wrong;
     }
-    if (again.from_cache) EXPECT_EQ(run_bytes(again.reference), truth) << "byte " << at;
+    if (again.from_cache) {
+      EXPECT_EQ(run_bytes(again.reference), truth) << "byte " << at;
+    }
   }
   EXPECT_GT(positions, 90);
   EXPECT_EQ(served_wrong, 0);
@@ -321,12 +331,65 @@ TEST_F(InfraHunt, AnEngineThatMisreportsTheScenesBodiesIsAnError) {
   EXPECT_FALSE(honest.passed());
   for (auto lie : std::vector<std::function<void(BodyMeta&)>>{
            [](BodyMeta& m) { m.mass = 0.0; }, [](BodyMeta& m) { m.is_static = true; m.mass = 0.0; },
-           [](BodyMeta& m) { m.mass *= 1e-3; }, [](BodyMeta& m) { m.radius = 0.0; }, [](BodyMeta& m) { m.name = "b"; }}) {
+           [](BodyMeta& m) { m.mass *= 1e-3; }, [](BodyMeta& m) { m.radius = 0.0; }, [](BodyMeta& m) { m.name.push_back('2'); }}) {
     const RunRecord r = run_with(lie);
     EXPECT_EQ(r.status, RunStatus::Error) << r.reason;
     EXPECT_FALSE(r.passed());
     EXPECT_NE(r.reason.find("reports the scene's body 0 (\"a\")"), std::string::npos) << r.reason;
   }
+}
+
+// --- -j's child processes: tried and right ------------------------------------------
+
+// A child that ends its own process while stepping: with status 0 and no record, or after
+// writing garbage onto every descriptor it holds (the record's pipe among them). Neither
+// may come back `ok`; a healthy run beside them is unaffected.
+TEST_F(InfraHunt, AChildThatExitsZeroOrWritesGarbageIsAnError) {
+  put(dir_ / "free.toml", pair_scene("free", "-1"));
+  ScenarioLoad load = load_scenario_file(dir_ / "free.toml");
+  ASSERT_TRUE(load.scene);
+  RunOptions options;
+  options.isolate = true;
+  // core, ending its process at the third step.
+  class Ending : public Engine {
+   public:
+    explicit Ending(int how) : inner_(find_engine("core")->create()), how_(how) {}
+    const EngineInfo& info() const override { return inner_->info(); }
+    void load(const Scene& scene) override { inner_->load(scene); }
+    void step(double dt) override {
+      inner_->step(dt);
+      if (++steps_ < 3) return;
+      if (how_ == 1) {
+        const char junk[] = "1rvp\0\0\0\0garbage that is no run record at all";
+        for (int fd = 3; fd < 256; ++fd) (void)!::write(fd, junk, sizeof junk);
+      }
+      ::_exit(0);
+    }
+    double time() const override { return inner_->time(); }
+    std::size_t body_count() const override { return inner_->body_count(); }
+    BodyMeta body_meta(std::size_t i) const override { return inner_->body_meta(i); }
+    void read_states(std::vector<BodyState>& out) const override { inner_->read_states(out); }
+    const std::vector<ContactEvent>& contacts() const override { return inner_->contacts(); }
+    std::vector<Setting> settings() const override { return inner_->settings(); }
+
+   private:
+    std::unique_ptr<Engine> inner_;
+    int how_;
+    int steps_ = 0;
+  };
+  auto engine_that = [](int how) {
+    EngineFactory f;
+    f.info = find_engine("core")->info;
+    f.create = [how] { return std::make_unique<Ending>(how); };
+    return f;
+  };
+  for (int how : {0, 1}) {
+    const RunRecord r = run_engine_isolated(*load.scene, engine_that(how), options);
+    EXPECT_EQ(r.status, RunStatus::Error) << how << ": " << r.reason;
+    EXPECT_FALSE(r.passed());
+  }
+  const RunRecord fine = run_engine_isolated(*load.scene, *find_engine("core"), options);
+  EXPECT_EQ(fine.status, RunStatus::Ok) << fine.reason;
 }
 
 }  // namespace
