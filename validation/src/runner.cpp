@@ -112,8 +112,15 @@ std::string object_name(const Scene& scene, const std::vector<BodyMeta>& metas, 
   return "?";
 }
 
-void refresh_metas(const Engine& engine, std::vector<BodyMeta>& metas) {
+void refresh_metas(const Engine& engine, std::vector<BodyMeta>& metas, const Scene& scene) {
   const std::size_t n = engine.body_count();
+  // Objects beyond the scene's bodies are particles, which only emitters make. Others (a
+  // helper body an engine made for itself, a body doubled) would be counted in the
+  // energy and momenta: one that took up the energy the scene's bodies lost hid it.
+  if (n > scene.bodies.size() && scene.emitters.empty()) {
+    throw std::runtime_error(engine.info().name + " reports " + std::to_string(n) + " bodies, but the scene has " +
+                             std::to_string(scene.bodies.size()) + " and no emitter to make more");
+  }
   for (std::size_t i = metas.size(); i < n; ++i) metas.push_back(engine.body_meta(i));
 }
 
@@ -193,7 +200,7 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     engine->load(scene);
     r.load_seconds = std::chrono::duration<double>(clock::now() - t_load).count();
     r.settings = engine->settings();
-    refresh_metas(*engine, r.bodies);
+    refresh_metas(*engine, r.bodies, scene);
     check_scene_bodies(scene, r.bodies, factory.info.name);
 
     // Probes: every step, for the bodies the expectations name.
@@ -219,7 +226,7 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     // drift (inf - inf) was skipped as NaN and read 0, a vacuous pass of any gate.
     auto sample = [&](double t) {
       engine->read_states(states);
-      refresh_metas(*engine, r.bodies);
+      refresh_metas(*engine, r.bodies, scene);
       r.series.time.push_back(t);
       const Totals totals = compute_totals(scene, r.bodies, states);
       r.series.totals.push_back(totals);
@@ -284,7 +291,7 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
       r.steps = k;
       const std::vector<ContactEvent>& events = engine->contacts();
       if (!events.empty()) {
-        refresh_metas(*engine, r.bodies);
+        refresh_metas(*engine, r.bodies, scene);
         for (const ContactEvent& e : events) {
           r.contacts.push_back({object_name(scene, r.bodies, e.a), object_name(scene, r.bodies, e.b), e.time, k});
         }
@@ -317,7 +324,7 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     r.limits_hit = engine->limits_hit();
     engine->read_states(states);
     r.final_states = states;
-    refresh_metas(*engine, r.bodies);
+    refresh_metas(*engine, r.bodies, scene);
     r.containment = containment.record();
   } catch (const std::exception& e) {
     r.status = RunStatus::Error;

@@ -339,6 +339,66 @@ TEST_F(InfraHunt, AnEngineThatMisreportsTheScenesBodiesIsAnError) {
   }
 }
 
+// core slowing its one body 1% a step, with a phantom body (not in the scene) that takes
+// up exactly the kinetic energy the scene's body loses.
+class PhantomEngine : public Engine {
+ public:
+  PhantomEngine() : inner_(find_engine("core")->create()) {}
+  const EngineInfo& info() const override { return inner_->info(); }
+  void load(const Scene& scene) override { inner_->load(scene); }
+  void step(double dt) override {
+    inner_->step(dt);
+    slowed_ *= 0.99;
+  }
+  double time() const override { return inner_->time(); }
+  std::size_t body_count() const override { return inner_->body_count() + 1; }
+  BodyMeta body_meta(std::size_t i) const override {
+    return i < inner_->body_count() ? inner_->body_meta(i) : BodyMeta{"phantom", 1.0, 0.1, false};
+  }
+  void read_states(std::vector<BodyState>& out) const override {
+    inner_->read_states(out);
+    double lost = 0.0;
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      const double m = inner_->body_meta(i).mass;
+      lost += 0.5 * m * length_squared(out[i].velocity) * (1.0 - slowed_ * slowed_);
+      out[i].velocity = slowed_ * out[i].velocity;
+    }
+    BodyState phantom = out.front();
+    phantom.position = {0.0, 50.0};
+    phantom.velocity = {0.0, std::sqrt(2.0 * lost / 1.0)};
+    out.push_back(phantom);
+  }
+  const std::vector<ContactEvent>& contacts() const override { return inner_->contacts(); }
+  std::vector<Setting> settings() const override { return inner_->settings(); }
+
+ private:
+  std::unique_ptr<Engine> inner_;
+  double slowed_ = 1.0;
+};
+
+// An engine reporting more bodies than the scene has, in a scene without emitters (no
+// particles can exist): the extra one was counted in the energy. One that took up the
+// energy the scene's body lost read an energy drift of round-off, and an energy_drift
+// gate of 1e-9 passed a run that lost 63% of its speed.
+TEST_F(InfraHunt, AnEngineReportingBodiesTheSceneDoesNotHaveIsAnError) {
+  put(dir_ / "free.toml", "name = \"free\"\nduration = 1.0\ndt = 0.01\n[[bodies]]\nname = \"a\"\nradius = 0.1\nmass = 2\n"
+                          "position = [0, 0]\nvelocity = [1, 0]\n[gate]\nenergy_drift = 1e-9\n");
+  ScenarioLoad load = load_scenario_file(dir_ / "free.toml");
+  ASSERT_TRUE(load.scene);
+  RunOptions options;
+  options.isolate = false;
+  const Reference reference = make_reference(*load.scene, options);
+  EngineFactory f;
+  f.info = find_engine("core")->info;
+  f.info.name = "phantom";
+  f.create = [] { return std::make_unique<PhantomEngine>(); };
+  RunRecord r = run_engine(*load.scene, f, options);
+  if (r.status == RunStatus::Ok) compare_run(r, *load.scene, reference, true);
+  EXPECT_EQ(r.status, RunStatus::Error) << r.reason;
+  EXPECT_FALSE(r.passed());
+  EXPECT_NE(r.reason.find("reports 2 bodies, but the scene has 1 and no emitter"), std::string::npos) << r.reason;
+}
+
 // --- -j's child processes: tried and right ------------------------------------------
 
 // A child that ends its own process while stepping: with status 0 and no record, or after
