@@ -12,6 +12,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string_view>
 #include <thread>
 
 #include "physval/adapters/registry.hpp"
@@ -69,18 +70,16 @@ json reference_to_json(const std::string& key, const Reference& ref) {
 // reference than the one computed.
 constexpr std::size_t kSealSize = 1 + 32;
 
-std::string sealed(const std::vector<std::uint8_t>& cbor) {
-  std::string bytes(cbor.begin(), cbor.end());
-  const std::string seal = hash_file_bytes(bytes);
-  return bytes + '\n' + seal;
+std::string seal_of(const std::vector<std::uint8_t>& cbor) {
+  return '\n' + hash_file_bytes(std::string_view(reinterpret_cast<const char*>(cbor.data()), cbor.size()));
 }
 
 std::optional<Reference> reference_from(const std::string& entry, const std::string& key) {
   if (entry.size() <= kSealSize || entry[entry.size() - kSealSize] != '\n') return std::nullopt;
-  const std::string bytes = entry.substr(0, entry.size() - kSealSize);
-  if (hash_file_bytes(bytes) != entry.substr(entry.size() - kSealSize + 1)) return std::nullopt;
+  const std::string_view bytes(entry.data(), entry.size() - kSealSize);
+  if (hash_file_bytes(bytes) != std::string_view(entry).substr(entry.size() - kSealSize + 1)) return std::nullopt;
   try {
-    const json j = json::from_cbor(bytes);
+    const json j = json::from_cbor(bytes.begin(), bytes.end());
     if (j.at("key").get<std::string>() != key) return std::nullopt;
     Reference ref;
     ref.available = j.at("available").get<bool>();
@@ -105,11 +104,13 @@ void store(const std::filesystem::path& dir, const std::string& name, const std:
   tmp_name << ".tmp-" << ::getpid() << '-' << std::hash<std::thread::id>{}(std::this_thread::get_id()) << '-'
            << counter.fetch_add(1) << '-' << name;
   const std::filesystem::path tmp = dir / tmp_name.str();
-  const std::string bytes = sealed(json::to_cbor(reference_to_json(key, ref)));
+  const std::vector<std::uint8_t> bytes = json::to_cbor(reference_to_json(key, ref));
+  const std::string seal = seal_of(bytes);
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) return;
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    out.write(seal.data(), static_cast<std::streamsize>(seal.size()));
     out.flush();
     if (!out) {
       out.close();
@@ -128,7 +129,7 @@ void store(const std::filesystem::path& dir, const std::string& name, const std:
 #if defined(__clang__) || defined(__GNUC__)
 __attribute__((no_sanitize("address", "undefined")))
 #endif
-std::string hash_file_bytes(const std::string& bytes) {
+std::string hash_file_bytes(std::string_view bytes) {
   std::uint64_t h1 = 14695981039346656037ull ^ bytes.size(), h2 = 0x9e3779b97f4a7c15ull;
   const std::size_t words = bytes.size() / 8;
   for (std::size_t i = 0; i < words; ++i) {
@@ -139,7 +140,7 @@ std::string hash_file_bytes(const std::string& bytes) {
     h2 = (h2 ^ w) * 0xc4ceb9fe1a85ec53ull + 0x632be59bd9b4e019ull;
     h2 ^= h2 >> 29;
   }
-  return hash_hex(bytes.substr(8 * words) + std::to_string(h1) + ":" + std::to_string(h2));
+  return hash_hex(std::string(bytes.substr(8 * words)) + std::to_string(h1) + ":" + std::to_string(h2));
 }
 
 // The running executable's bytes, hashed once: any rebuild of physval with other code

@@ -6,13 +6,14 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 
 #include "physval/validation/comparator.hpp"
 
 namespace physval {
 
 // A 128-bit hash of bytes (hex, 32 digits): cache entries' seals, file identities.
-std::string hash_file_bytes(const std::string& bytes);
+std::string hash_file_bytes(std::string_view bytes);
 
 // The hash of the running physval executable's bytes (computed once): any rebuild with
 // other code has another, even at the same version number.
