@@ -221,11 +221,35 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     for (const ExpectedPeriod& p : scene.expect.period) add_probe(p.body, true, p.around);
 
     const long every = sample_every(scene, options.max_sample_states);
+    // Which of the scene's bodies anything in the scene can destroy: a collision-matrix
+    // destroy rule (any body may meet one), or an explode emitter (its parent). Positions
+    // of a body dead in either run are not compared, so an engine that reported bodies
+    // destroyed that nothing destroys was compared on nothing but its energy: with
+    // friction in the scene (no energy conserved) a position gate passed it.
+    const bool destroy_rules = std::any_of(scene.collision_matrix.begin(), scene.collision_matrix.end(), [](const CollisionRule& c) {
+      return c.response == CollisionResponse::DestroyA || c.response == CollisionResponse::DestroyB ||
+             c.response == CollisionResponse::DestroyBoth;
+    });
+    std::vector<bool> may_die(scene.bodies.size(), destroy_rules);
+    for (const EmitterDef& e : scene.emitters) {
+      if (e.mode != EmitterMode::Explode) continue;
+      if (const int i = scene.body_index(e.parent); i >= 0) may_die[static_cast<std::size_t>(i)] = true;
+    }
+    auto check_deaths = [&] {
+      for (std::size_t i = 0; i < may_die.size() && i < states.size(); ++i) {
+        if (!states[i].alive && !may_die[i]) {
+          throw std::runtime_error(factory.info.name + " reports the scene's body " + std::to_string(i) + " (\"" +
+                                   scene.bodies[i].name + "\") destroyed, but nothing in the scene destroys it (no " +
+                                   "collision-matrix destroy rule, no explode emitter of it)");
+        }
+      }
+    };
     // A sample is finite when every live body's state is and so are the totals made of
     // them: a body at 1e160 m/s has a finite state and an infinite kinetic energy, whose
     // drift (inf - inf) was skipped as NaN and read 0, a vacuous pass of any gate.
     auto sample = [&](double t) {
       engine->read_states(states);
+      check_deaths();
       refresh_metas(*engine, r.bodies, scene);
       r.series.time.push_back(t);
       const Totals totals = compute_totals(scene, r.bodies, states);

@@ -399,6 +399,64 @@ TEST_F(InfraHunt, AnEngineReportingBodiesTheSceneDoesNotHaveIsAnError) {
   EXPECT_NE(r.reason.find("reports 2 bodies, but the scene has 1 and no emitter"), std::string::npos) << r.reason;
 }
 
+// core, reporting every body destroyed (alive = false) from its third step on.
+class VanishingEngine : public Engine {
+ public:
+  VanishingEngine() : inner_(find_engine("core")->create()) {}
+  const EngineInfo& info() const override { return inner_->info(); }
+  void load(const Scene& scene) override { inner_->load(scene); }
+  void step(double dt) override {
+    inner_->step(dt);
+    ++steps_;
+  }
+  double time() const override { return inner_->time(); }
+  std::size_t body_count() const override { return inner_->body_count(); }
+  BodyMeta body_meta(std::size_t i) const override { return inner_->body_meta(i); }
+  void read_states(std::vector<BodyState>& out) const override {
+    inner_->read_states(out);
+    if (steps_ >= 3) {
+      for (BodyState& b : out) b.alive = false;
+    }
+  }
+  const std::vector<ContactEvent>& contacts() const override { return inner_->contacts(); }
+  std::vector<Setting> settings() const override { return inner_->settings(); }
+
+ private:
+  std::unique_ptr<Engine> inner_;
+  int steps_ = 0;
+};
+
+// Positions of a body dead in either run are not compared (a destroy rule may remove it
+// in one engine and not another). An engine reporting every body destroyed in a scene
+// that destroys nothing was compared on nothing but energy and momentum: in a scene with
+// friction (no energy conserved) a gate of position_divergence = 1e-6 passed it.
+TEST_F(InfraHunt, AnEngineReportingBodiesDestroyedThatNothingDestroysIsAnError) {
+  const std::string slide = "name = \"slide\"\nduration = 1.0\ndt = 0.01\n[world]\ngravity = [0, -9.81]\n"
+                            "[[bodies]]\nname = \"a\"\nradius = 0.1\nmass = 2\nposition = [0, 0.1]\nvelocity = [3, 0]\n"
+                            "friction = 0.5\n[[walls]]\nname = \"floor\"\nfrom = [-10, 0]\nto = [10, 0]\nfriction = 0.5\n"
+                            "[gate]\nposition_divergence = 1e-6\n";
+  put(dir_ / "slide.toml", slide);
+  ScenarioLoad load = load_scenario_file(dir_ / "slide.toml");
+  ASSERT_TRUE(load.scene) << (load.errors.empty() ? "" : load.errors.front().str());
+  RunOptions options;
+  options.isolate = false;
+  const Reference reference = make_reference(*load.scene, options);
+  ASSERT_TRUE(reference.available && reference.converged) << reference.reason;
+  EngineFactory f;
+  f.info = find_engine("core")->info;
+  f.info.name = "vanishing";
+  f.create = [] { return std::make_unique<VanishingEngine>(); };
+  RunRecord r = run_engine(*load.scene, f, options);
+  if (r.status == RunStatus::Ok) compare_run(r, *load.scene, reference, true);
+  EXPECT_EQ(r.status, RunStatus::Error) << r.reason;
+  EXPECT_FALSE(r.passed());
+  EXPECT_NE(r.reason.find("destroyed, but nothing in the scene destroys it"), std::string::npos) << r.reason;
+  // core itself, honest, passes the same gate.
+  RunRecord honest = run_engine(*load.scene, *find_engine("core"), options);
+  compare_run(honest, *load.scene, reference, true);
+  EXPECT_TRUE(honest.passed()) << honest.reason;
+}
+
 // --- -j's child processes: tried and right ------------------------------------------
 
 // A child that ends its own process while stepping: with status 0 and no record, or after
