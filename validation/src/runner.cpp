@@ -307,6 +307,7 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     const auto loop_t0 = clock::now();
     const StepTicks loop_ticks0 = step_ticks();
     StepTicks step_ticks_total = 0;
+    double stepped = 0.0;   // the time the steps asked for add up to
     for (long k = 1; k <= n && r.status == RunStatus::Ok; ++k) {
       const double h = k == n ? last_dt : scene.dt;
       const StepTicks t0 = step_ticks();
@@ -321,6 +322,14 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
         }
       }
       const double t = engine->time();
+      // Samples are paired with the reference's by this clock (to 1% of a step): one that
+      // is not the steps taken paired no sample, or the wrong ones, and a run whose clock
+      // ran 0.1% fast measured a position divergence of 0.
+      stepped += h;
+      if (!(std::abs(t - stepped) <= 0.01 * scene.dt)) {
+        throw std::runtime_error(factory.info.name + " reports its time as " + std::to_string(t) + " s after step " +
+                                 std::to_string(k) + ", but it was stepped " + std::to_string(stepped) + " s");
+      }
       const bool sampled = (k % every == 0) || k == n;
       if (std::string broken = engine->broken_guarantee(); !broken.empty()) {
         sample(t);

@@ -457,6 +457,58 @@ TEST_F(InfraHunt, AnEngineReportingBodiesDestroyedThatNothingDestroysIsAnError) 
   EXPECT_TRUE(honest.passed()) << honest.reason;
 }
 
+// core, with its clock misreported: `scale` x the time it stepped (a plugin counting
+// in another unit, or not counting the shortened last step).
+class MistimedEngine : public Engine {
+ public:
+  explicit MistimedEngine(double scale) : inner_(find_engine("core")->create()), scale_(scale) {}
+  const EngineInfo& info() const override { return inner_->info(); }
+  void load(const Scene& scene) override { inner_->load(scene); }
+  void step(double dt) override { inner_->step(dt); }
+  double time() const override { return scale_ * inner_->time(); }
+  std::size_t body_count() const override { return inner_->body_count(); }
+  BodyMeta body_meta(std::size_t i) const override { return inner_->body_meta(i); }
+  void read_states(std::vector<BodyState>& out) const override { inner_->read_states(out); }
+  const std::vector<ContactEvent>& contacts() const override { return inner_->contacts(); }
+  std::vector<Setting> settings() const override { return inner_->settings(); }
+
+ private:
+  std::unique_ptr<Engine> inner_;
+  double scale_;
+};
+
+// Samples are paired with the reference's by their time, which is the engine's own
+// clock: an engine whose clock ran at another rate had no sample paired after t = 0, and
+// measured a position divergence of 0 whatever it did.
+TEST_F(InfraHunt, AnEngineWhoseClockIsNotTheStepsIsAnError) {
+  put(dir_ / "fall.toml", "name = \"fall\"\nduration = 1.0\ndt = 0.01\n[world]\ngravity = [0, -9.81]\n"
+                          "[[bodies]]\nname = \"a\"\nradius = 0.1\nmass = 2\nposition = [0, 0]\nvelocity = [3, 0]\n"
+                          "[gate]\nposition_divergence = 1e-6\n");
+  ScenarioLoad load = load_scenario_file(dir_ / "fall.toml");
+  ASSERT_TRUE(load.scene);
+  RunOptions options;
+  options.isolate = false;
+  const Reference reference = make_reference(*load.scene, options);
+  ASSERT_TRUE(reference.available && reference.converged) << reference.reason;
+  for (double scale : {2.0, 1.0 + 1e-3, 0.0}) {
+    EngineFactory f;
+    f.info = find_engine("core")->info;
+    f.info.name = "mistimed";
+    f.create = [scale] { return std::make_unique<MistimedEngine>(scale); };
+    RunRecord r = run_engine(*load.scene, f, options);
+    if (r.status == RunStatus::Ok) compare_run(r, *load.scene, reference, true);
+    EXPECT_EQ(r.status, RunStatus::Error) << scale << ": " << r.reason;
+    EXPECT_FALSE(r.passed()) << scale;
+    EXPECT_NE(r.reason.find("reports its time as"), std::string::npos) << r.reason;
+  }
+  EngineFactory honest;
+  honest.info = find_engine("core")->info;
+  honest.create = [] { return std::make_unique<MistimedEngine>(1.0); };
+  RunRecord r = run_engine(*load.scene, honest, options);
+  compare_run(r, *load.scene, reference, true);
+  EXPECT_TRUE(r.passed()) << r.reason;
+}
+
 // --- -j's child processes: tried and right ------------------------------------------
 
 // A child that ends its own process while stepping: with status 0 and no record, or after
