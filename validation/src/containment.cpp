@@ -381,6 +381,9 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
       const double reach_j = (ri + rj) * (1.0 + 1e-9);
       if (sorted_y_[q].lo > yhi + reach_j || sorted_y_[q].hi < ylo - reach_j) continue;
       if (!pair_collides_[gi + body_group_[j]]) continue;
+      // Two points: no overlap can be deeper than 0 (max_penetration starts there), and they
+      // are never counted as passed into each other (that wants a radius, see below).
+      if (ri == 0.0 && rj == 0.0) continue;
       const Vec2 xj = pos_[j];
       const double depth = ri + rj - length(xi - xj);
       if (depth > record_.max_penetration) {
@@ -394,6 +397,9 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
       // when both steps were straight (neither body met anything in it), each bend added.
       // A point (radius 0) has passed into a circle when it gets half-way to its centre.
       const double smaller = std::min(ri, rj) > 0.0 ? std::min(ri, rj) : 0.5 * std::max(ri, rj);
+      // Two points (no radius either, or a radius that is not a number) are never counted as
+      // passed into each other (the test at the end wants smaller > 0): nothing below for them.
+      if (!(smaller > 0.0)) continue;
       // Of two circles of unequal size, the small one has gone into the large one when it
       // is wholly inside it (centres closer than the difference of the radii: an overlap
       // deeper than the small one's diameter): a 1 cm ball at 10-300 m/s went 0.5 m deep

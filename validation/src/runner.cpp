@@ -251,6 +251,7 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     const auto loop_t0 = clock::now();
     const StepTicks loop_ticks0 = step_ticks();
     StepTicks step_ticks_total = 0;
+    long until_sample = every;   // steps to the next sample: k % every == 0 without a division a step
     for (long k = 1; k <= n && r.status == RunStatus::Ok; ++k) {
       const double h = k == n ? last_dt : scene.dt;
       const StepTicks t0 = step_ticks();
@@ -265,7 +266,9 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
         }
       }
       const double t = engine->time();
-      const bool sampled = (k % every == 0) || k == n;
+      const bool on_interval = --until_sample == 0;
+      if (on_interval) until_sample = every;
+      const bool sampled = on_interval || k == n;
       if (std::string broken = engine->broken_guarantee(); !broken.empty()) {
         sample(t);
         r.status = RunStatus::Diverged;
