@@ -80,6 +80,7 @@ ContainmentMonitor::ContainmentMonitor(const Scene& scene) : scene_(scene) {
   }
   eps_ = 1e-9 * extent;
   for (const BodyDef& d : scene.bodies) radius_.push_back(d.shape == ShapeKind::Point ? 0.0 : d.radius);
+  pairs_possible_ = std::any_of(moving_.begin(), moving_.end(), [&](std::size_t i) { return radius_[i] != 0.0; });
   max_radius_ = max_radius;
   for (const Barrier& b : barriers_) {
     const double r = b.circle ? b.radius : 0.0;
@@ -250,7 +251,10 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
   // The sort compares the left ends laid out in the order's order (sorted_lo_, gathered
   // first), moving them with the order: the same comparisons on the same values as
   // reading lo_ through the order, without the indirection.
-  const std::size_t n = order_.size();
+  // Only points move (orbits, projectiles): no pair of them can overlap or count as passed
+  // into each other (the pair test below leaves every such pair at once), so the sweep is
+  // skipped as a whole; the barriers are still checked for every body.
+  const std::size_t n = pairs_possible_ ? order_.size() : 0;
   sorted_lo_.resize(n);
   for (std::size_t p = 0; p < n; ++p) sorted_lo_[p] = lo_[order_[p]];
   for (std::size_t p = 1; p < n; ++p) {
@@ -454,7 +458,21 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
     }
   }
 
-  // Each moving body against the barriers near its path since the last step.
+  // Each moving body against the barriers near its path since the last step (with none,
+  // only the step's end is remembered, as at the end of the loop below).
+  if (barriers_.empty()) {
+    for (const std::size_t i : moving_) {
+      if (!alive_[i]) {
+        previous_alive_[i] = 0;
+        continue;
+      }
+      previous_[i] = pos_[i];
+      previous_velocity_[i] = states[i].velocity;
+      previous_alive_[i] = 1;
+    }
+    previous_time_ = t;
+    return;
+  }
   for (std::size_t i : moving_) {
     if (!alive_[i]) {
       previous_alive_[i] = 0;
