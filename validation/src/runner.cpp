@@ -279,7 +279,9 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
         r.reason = "state became NaN or infinite (a position or velocity, or the energy or momentum made of them)";
         r.diverged_at = t;
       }
-      if (!sampled) engine->read_states(states);
+      // Containment and the probes read positions, velocities and liveness only (the
+      // angles in `states` may be a sample's until the next one).
+      if (!sampled) engine->read_motion(states);
       containment.observe(t, states);
       update_probes(t, h, true);
     }
