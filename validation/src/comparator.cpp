@@ -360,6 +360,24 @@ Reference make_reference(const Scene& scene, const RunOptions& options) {
   int refine = 8;
   const double body_steps = static_cast<double>(std::max<std::size_t>(1, scene.bodies.size())) * scene.steps();
   while (refine > 2 && body_steps * refine > 4e7) refine /= 2;
+  // Neither run may pass the most steps a run takes (Scene::kMaxSteps): beyond it the
+  // step count saturates and the run would end in one giant last step (a scene of 6e8 steps
+  // had its fine reference of 1.2e9 steps cut to 1e9 and a last step of 2e8 dt).
+  const double scene_steps = static_cast<double>(scene.steps());
+  while (refine > 2 && scene_steps * refine > Scene::kMaxSteps) refine /= 2;
+  if (scene_steps * refine > Scene::kMaxSteps) {
+    ref.reason = "the reference would need " + show(scene_steps * refine) + " steps at dt/" + std::to_string(refine) +
+                 ", more than a run takes (" + show(static_cast<double>(Scene::kMaxSteps)) + ")";
+    return ref;
+  }
+  // And its steps must be normal numbers (a dt of 5e-324 s halves to 0: the reference's
+  // run never advanced and filled the memory; the loader refuses such a dt, this guards
+  // the rest).
+  if (!(scene.dt / refine >= std::numeric_limits<double>::min())) {
+    ref.reason = "the reference's step dt/" + std::to_string(refine) + " = " + show(scene.dt / refine) +
+                 " s is below the smallest normal double";
+    return ref;
+  }
   const long every = sample_every(scene, options.max_sample_states);
   auto variant = [&](int factor) {
     Scene s = scene;
