@@ -16,6 +16,7 @@ bouncing ball, durations and steps at float limits).
 import json, math, os, sys
 
 G = 9.81
+WIDE = os.environ.get("HUNT5_WIDE") == "1"
 
 
 def gen(root):
@@ -57,13 +58,14 @@ friction = {mu!r}
 
     # (a) pile: n circles dropped into a box (walls or thin boxes), e, mu, dt, sizes, masses.
     import random
-    for n in [3, 8, 20]:
-        for e in [0.0, 0.5, 1.0]:
+    for n in ([40, 60] if WIDE else [3, 8, 20]):
+        for e in ([0.0, 0.9] if WIDE else [0.0, 0.5, 1.0]):
             for mu in [0.0, 0.4]:
-                for dt in ["1/60", "1/20"]:
+                for dt in (["1/10", "1/5"] if WIDE else ["1/60", "1/20"]):
                     for kind in ["walls", "boxes"]:
                         rnd = random.Random(n * 1000 + int(e * 10) + int(mu * 10) * 7 + len(dt) + len(kind))
-                        w, h = 1.5, 6.0
+                        w, h = (3.0, 8.0) if WIDE else (1.5, 6.0)
+                        vmax = 30.0 if WIDE else 3.0
                         bodies = ""
                         placed = []
                         i = 0
@@ -81,11 +83,11 @@ name = "p{k}"
 radius = {r}
 mass = {m}
 position = [{x!r}, {y!r}]
-velocity = [{rnd.uniform(-3, 3)!r}, {rnd.uniform(-3, 3)!r}]
+velocity = [{rnd.uniform(-vmax, vmax)!r}, {rnd.uniform(-vmax, vmax)!r}]
 restitution = {e}
 friction = {mu}
 """
-                        name = f"pile_{n}_{int(e*10)}_{int(mu*10)}_{dt.split('/')[1]}_{kind}"
+                        name = f"pile_{n}_{int(e*10)}_{int(mu*10)}_{dt.split('/')[-1]}_{kind}"
                         write(name, f"""name = "{name}"
 duration = 3.0
 dt = "{dt}"
@@ -124,15 +126,16 @@ gravity = [0.0, -9.81]
             return s, 0.0
         return s + 0.5 * ad * (T - t - t1) ** 2, ad * (T - t - t1)
 
-    for deg in [5, 15, 25, 35, 50, 70]:
-        for mus, muk in [(0.0, 0.0), (0.3, 0.2), (0.5, 0.3), (0.8, 0.5), (1.2, 1.0), (0.3, 0.3)]:
+    for deg in ([1, 45, 80, 89] if WIDE else [5, 15, 25, 35, 50, 70]):
+        for mus, muk in ([(0.0, 0.0), (1.0, 0.99), (5.0, 0.1), (60.0, 50.0)] if WIDE else
+                         [(0.0, 0.0), (0.3, 0.2), (0.5, 0.3), (0.8, 0.5), (1.2, 1.0), (0.3, 0.3)]):
             for v0 in [0.0, 2.0, -2.0]:
                 for order in ["down", "up"]:
                     th = math.radians(deg)
                     sn, cs = math.sin(th), math.cos(th)
                     if abs(math.tan(th) - mus) < 1e-6:
                         continue
-                    r, T, L = 0.2, 2.0, 200.0
+                    r, T, L = (0.001 if WIDE else 0.2), 2.0, 200.0
                     d = (cs, -sn)        # down-slope direction
                     nrm = (sn, cs)       # outward normal
                     a_pt = (-L * cs / 2, L * sn / 2)
@@ -171,10 +174,10 @@ final = [ {{ body = "b", position = [{pos[0]!r}, {pos[1]!r}], velocity = [{vel[0
     # (c) triple: a ball dropped centred onto two balls resting apart (gap) on a floor, and
     # three balls meeting at 120 degrees; every numbering; mirror symmetry is the oracle.
     perms = [(0, 1, 2), (2, 1, 0), (1, 0, 2), (1, 2, 0)]
-    for e in [0.0, 0.5, 1.0]:
-        for mu in [0.0, 0.3]:
-            for gap in [0.0, 0.1]:
-                for mass_top in [0.5, 1.0, 4.0]:
+    for e in ([0.3, 0.9] if WIDE else [0.0, 0.5, 1.0]):
+        for mu in ([0.0, 1.0] if WIDE else [0.0, 0.3]):
+            for gap in ([1e-9, 0.5] if WIDE else [0.0, 0.1]):
+                for mass_top in ([1e-3, 1e3] if WIDE else [0.5, 1.0, 4.0]):
                     for pi, perm in enumerate(perms):
                         r = 0.5
                         bs = [("top", mass_top, (0.0, 3.0)), ("left", 1.0, (-(r + gap / 2), r)), ("right", 1.0, (r + gap / 2, r))]
@@ -203,9 +206,9 @@ to = [20.0, 0.0]
 restitution = {e}
 friction = {mu}
 """, family="triple_drop", group=f"triple_drop_{int(e*10)}_{int(mu*10)}_{int(gap*10)}_{int(mass_top*10)}")
-    for e in [0.0, 0.5, 1.0]:
-        for v in [1.0, 10.0]:
-            for dt in ["1/60", "1/7"]:
+    for e in ([0.3, 0.9] if WIDE else [0.0, 0.5, 1.0]):
+        for v in ([100.0, 1000.0] if WIDE else [1.0, 10.0]):
+            for dt in (["1/60", "1/2"] if WIDE else ["1/60", "1/7"]):
                 for pi, perm in enumerate(perms):
                     r = 0.5
                     bs = []
@@ -224,7 +227,7 @@ position = [{p[0]!r}, {p[1]!r}]
 velocity = [{vv[0]!r}, {vv[1]!r}]
 restitution = {e}
 """
-                    name = f"triple_meet_{int(e*10)}_{int(v)}_{dt.split('/')[1]}_{pi}"
+                    name = f"triple_meet_{int(e*10)}_{int(v)}_{dt.split('/')[-1]}_{pi}"
                     write(name, f"""name = "{name}"
 duration = 1.5
 dt = "{dt}"
@@ -232,9 +235,9 @@ dt = "{dt}"
 
     # (d) drag: a ball thrown at a wall then the floor with quadratic (or linear) drag, e 0.5-1.
     for kind in ["quadratic", "linear"]:
-        for k in [0.01, 0.1, 0.5]:
-            for e in [0.5, 1.0]:
-                for v0 in [5.0, 20.0]:
+        for k in ([2.0, 10.0] if WIDE else [0.01, 0.1, 0.5]):
+            for e in ([0.0, 0.9] if WIDE else [0.5, 1.0]):
+                for v0 in ([50.0, 200.0] if WIDE else [5.0, 20.0]):
                     name = f"dragwall_{kind}_{int(k*100)}_{int(e*10)}_{int(v0)}"
                     key = "drag_quadratic" if kind == "quadratic" else "drag_linear"
                     write(name, f"""name = "{name}"
@@ -263,9 +266,9 @@ restitution = {e}
 
     # (e) escape: a fast body in a box of walls or thin boxes, big dt, CCD on/off.
     for shape in ["circle", "point"]:
-        for v in [20.0, 200.0, 2000.0]:
-            for dt in ["1/60", "1/10", "1/2"]:
-                for kind, thick in [("walls", 0.0), ("boxes", 0.001), ("boxes", 0.05)]:
+        for v in ([1e4, 1e5] if WIDE else [20.0, 200.0, 2000.0]):
+            for dt in (["1/60", "1/1"] if WIDE else ["1/60", "1/10", "1/2"]):
+                for kind, thick in ([("boxes", 0.02), ("boxes", 1.0)] if WIDE else [("walls", 0.0), ("boxes", 0.001), ("boxes", 0.05)]):
                     for ccd in ["default", "off", "on"]:
                         if kind == "walls" and ccd == "on" and shape == "point":
                             continue
@@ -276,8 +279,8 @@ restitution = {e}
                             opts = "[box2d]\ncontinuous = false\n[bullet]\nccd = false\n"
                         elif ccd == "on":
                             opts = "[bullet]\nccd = true\ncontact_processing_threshold = 1e30\n"
-                        a = 0.37
-                        name = f"escape_{shape}_{int(v)}_{dt.split('/')[1]}_{kind}_{int(thick*1000)}_{ccd}"
+                        a = math.atan2(1.0, 0.9) if WIDE else 0.37   # WIDE: aimed at the corner (1, 2)
+                        name = f"escape_{shape}_{int(v)}_{dt.split('/')[-1]}_{kind}_{int(thick*1000)}_{ccd}"
                         write(name, f"""name = "{name}"
 duration = 2.0
 dt = "{dt}"

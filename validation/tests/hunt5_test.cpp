@@ -129,4 +129,45 @@ velocity = [1.0, 0.0]
   EXPECT_LT(seconds, 2.0) << ref.reason;
 }
 
+// A ball thrown at 200 m/s (then 50 m/s) against quadratic drag k2 = 10 N/(m/s)^2, 1 kg,
+// towards a wall at x = 3 over a floor (e 0.9). Drag only slows a body along its own
+// velocity: x never decreases while vx > 0, and vx never changes sign by drag, so the
+// ball's x stays >= 0 (it stops at x = 0.623 m: RK4 at 1e-5 s with exact impacts,
+// scripts/hunt5.py). The reference (core, RK4 at dt/8 = 2.1 ms, k |v| dt / m = 4.2)
+// reversed the ball 3 m within one step, the same at dt/4, so its two runs agreed to 0 m
+// and it was "converged", and every engine was measured against a ball 3.6 m from the
+// truth (Box2D, nearer the truth, 3.1 m "off"). Oracle: a reference that claims
+// convergence must keep x >= 0 throughout; a stiff-drag reference says it is not converged.
+TEST(Hunt5Reference, AReferenceUnderDragTooStiffForItsStepIsNotConverged) {
+  const physval::ScenarioLoad load =
+      physval::load_scenario_file(std::string(PHYSVAL_SOURCE_DIR) + "/validation/tests/hunt/stiff_quadratic_drag.toml");
+  ASSERT_TRUE(load.scene.has_value());
+  for (double speed : {200.0, 50.0}) {
+    physval::Scene s = *load.scene;
+    s.bodies[0].velocity = {speed, 0.3 * speed};
+    const physval::Reference ref = physval::make_reference(s, physval::RunOptions{});
+    ASSERT_TRUE(ref.run.has_value()) << ref.reason;
+    double x_min = 0.0;
+    for (const auto& row : ref.run->series.states) x_min = std::min(x_min, row[0].position.x);
+    if (ref.converged) {
+      EXPECT_GE(x_min, 0.0) << speed << " m/s: a converged reference went backwards against drag";
+    }
+    EXPECT_FALSE(ref.converged) << speed << " m/s";
+    EXPECT_NE(ref.reason.find("drag is too stiff for the reference's step"), std::string::npos) << ref.reason;
+  }
+  // Drag the reference's step resolves (k dt / m = 0.1) still converges, to the closed
+  // form of linear drag without impacts: x = v0 m / k (1 - exp(-k t / m)).
+  physval::Scene s = *load.scene;
+  s.walls.clear();
+  s.world.gravity = {0.0, 0.0};
+  s.bodies[0].drag_quadratic = 0.0;
+  s.bodies[0].drag_linear = 0.4;
+  s.bodies[0].velocity = {5.0, 0.0};
+  s.duration = 2.0;
+  const physval::Reference ref = physval::make_reference(s, physval::RunOptions{});
+  ASSERT_TRUE(ref.converged) << ref.reason;
+  const double x = ref.run->final_states[0].position.x;
+  EXPECT_NEAR(x, 5.0 / 0.4 * (1.0 - std::exp(-0.4 * 2.0)), 1e-6);
+}
+
 }  // namespace
