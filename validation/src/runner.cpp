@@ -112,9 +112,43 @@ std::string object_name(const Scene& scene, const std::vector<BodyMeta>& metas, 
   return "?";
 }
 
-void refresh_metas(const Engine& engine, std::vector<BodyMeta>& metas) {
+void refresh_metas(const Engine& engine, std::vector<BodyMeta>& metas, const Scene& scene) {
   const std::size_t n = engine.body_count();
+  // Objects beyond the scene's bodies are particles, which only emitters make. Others (a
+  // helper body an engine made for itself, a body doubled) would be counted in the
+  // energy and momenta: one that took up the energy the scene's bodies lost hid it.
+  if (n > scene.bodies.size() && scene.emitters.empty()) {
+    throw std::runtime_error(engine.info().name + " reports " + std::to_string(n) + " bodies, but the scene has " +
+                             std::to_string(scene.bodies.size()) + " and no emitter to make more");
+  }
   for (std::size_t i = metas.size(); i < n; ++i) metas.push_back(engine.body_meta(i));
+}
+
+// The scene's bodies as the engine reports them must be the scene's: the energy, the
+// momenta and containment are computed from the reported mass, radius and static flag.
+// An engine (a plugin) that reported its bodies massless or static had an energy and a
+// momentum of 0 at every sample, so every drift limit passed whatever it did. Masses
+// and radii are held to float32's round-off (Box2D derives mass from a density).
+void check_scene_bodies(const Scene& scene, const std::vector<BodyMeta>& metas, const std::string& engine) {
+  auto close = [](double a, double b) { return std::abs(a - b) <= 1e-5 * std::max(std::abs(a), std::abs(b)) + 1e-12; };
+  for (std::size_t i = 0; i < scene.bodies.size() && i < metas.size(); ++i) {
+    const BodyDef& want = scene.bodies[i];
+    const BodyMeta& got = metas[i];
+    std::string wrong;
+    if (got.name != want.name) {
+      wrong = "is named \"" + got.name + "\"";
+    } else if (got.is_static != want.is_static) {
+      wrong = got.is_static ? "is static" : "is not static";
+    } else if (!want.is_static && !close(got.mass, want.mass)) {
+      wrong = "has a mass of " + std::to_string(got.mass) + " kg (the scene's: " + std::to_string(want.mass) + " kg)";
+    } else if (!close(got.radius, want.radius)) {
+      wrong = "has a radius of " + std::to_string(got.radius) + " m (the scene's: " + std::to_string(want.radius) + " m)";
+    }
+    if (!wrong.empty()) {
+      throw std::runtime_error(engine + " reports the scene's body " + std::to_string(i) + " (\"" + want.name + "\") as one that " +
+                               wrong + ": its energy and momenta would not be the scene's");
+    }
+  }
 }
 
 bool states_finite(const std::vector<BodyState>& states) {
@@ -166,7 +200,8 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     engine->load(scene);
     r.load_seconds = std::chrono::duration<double>(clock::now() - t_load).count();
     r.settings = engine->settings();
-    refresh_metas(*engine, r.bodies);
+    refresh_metas(*engine, r.bodies, scene);
+    check_scene_bodies(scene, r.bodies, factory.info.name);
 
     // Probes: every step, for the bodies the expectations name.
     std::vector<ProbeTracker> trackers;
@@ -186,12 +221,36 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     for (const ExpectedPeriod& p : scene.expect.period) add_probe(p.body, true, p.around);
 
     const long every = sample_every(scene, options.max_sample_states);
+    // Which of the scene's bodies anything in the scene can destroy: a collision-matrix
+    // destroy rule (any body may meet one), or an explode emitter (its parent). Positions
+    // of a body dead in either run are not compared, so an engine that reported bodies
+    // destroyed that nothing destroys was compared on nothing but its energy: with
+    // friction in the scene (no energy conserved) a position gate passed it.
+    const bool destroy_rules = std::any_of(scene.collision_matrix.begin(), scene.collision_matrix.end(), [](const CollisionRule& c) {
+      return c.response == CollisionResponse::DestroyA || c.response == CollisionResponse::DestroyB ||
+             c.response == CollisionResponse::DestroyBoth;
+    });
+    std::vector<bool> may_die(scene.bodies.size(), destroy_rules);
+    for (const EmitterDef& e : scene.emitters) {
+      if (e.mode != EmitterMode::Explode) continue;
+      if (const int i = scene.body_index(e.parent); i >= 0) may_die[static_cast<std::size_t>(i)] = true;
+    }
+    auto check_deaths = [&] {
+      for (std::size_t i = 0; i < may_die.size() && i < states.size(); ++i) {
+        if (!states[i].alive && !may_die[i]) {
+          throw std::runtime_error(factory.info.name + " reports the scene's body " + std::to_string(i) + " (\"" +
+                                   scene.bodies[i].name + "\") destroyed, but nothing in the scene destroys it (no " +
+                                   "collision-matrix destroy rule, no explode emitter of it)");
+        }
+      }
+    };
     // A sample is finite when every live body's state is and so are the totals made of
     // them: a body at 1e160 m/s has a finite state and an infinite kinetic energy, whose
     // drift (inf - inf) was skipped as NaN and read 0, a vacuous pass of any gate.
     auto sample = [&](double t) {
       engine->read_states(states);
-      refresh_metas(*engine, r.bodies);
+      check_deaths();
+      refresh_metas(*engine, r.bodies, scene);
       r.series.time.push_back(t);
       const Totals totals = compute_totals(scene, r.bodies, states);
       r.series.totals.push_back(totals);
@@ -248,6 +307,7 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     const auto loop_t0 = clock::now();
     const StepTicks loop_ticks0 = step_ticks();
     StepTicks step_ticks_total = 0;
+    double stepped = 0.0;   // the time the steps asked for add up to
     for (long k = 1; k <= n && r.status == RunStatus::Ok; ++k) {
       const double h = k == n ? last_dt : scene.dt;
       const StepTicks t0 = step_ticks();
@@ -256,12 +316,20 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
       r.steps = k;
       const std::vector<ContactEvent>& events = engine->contacts();
       if (!events.empty()) {
-        refresh_metas(*engine, r.bodies);
+        refresh_metas(*engine, r.bodies, scene);
         for (const ContactEvent& e : events) {
           r.contacts.push_back({object_name(scene, r.bodies, e.a), object_name(scene, r.bodies, e.b), e.time, k});
         }
       }
       const double t = engine->time();
+      // Samples are paired with the reference's by this clock (to 1% of a step): one that
+      // is not the steps taken paired no sample, or the wrong ones, and a run whose clock
+      // ran 0.1% fast measured a position divergence of 0.
+      stepped += h;
+      if (!(std::abs(t - stepped) <= 0.01 * scene.dt)) {
+        throw std::runtime_error(factory.info.name + " reports its time as " + std::to_string(t) + " s after step " +
+                                 std::to_string(k) + ", but it was stepped " + std::to_string(stepped) + " s");
+      }
       const bool sampled = (k % every == 0) || k == n;
       if (std::string broken = engine->broken_guarantee(); !broken.empty()) {
         sample(t);
@@ -289,7 +357,7 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     r.limits_hit = engine->limits_hit();
     engine->read_states(states);
     r.final_states = states;
-    refresh_metas(*engine, r.bodies);
+    refresh_metas(*engine, r.bodies, scene);
     r.containment = containment.record();
   } catch (const std::exception& e) {
     r.status = RunStatus::Error;
