@@ -30,13 +30,15 @@
 #             level or tilted): core to 1e-8
 #   particles particles (5-500 m/s) bouncing in a closed box: none may end outside
 #   tiny      a 1 cm ball at 100-300 m/s off-centre through a resting 1 m ball
+#   stiffdrag a ball against quadratic drag too stiff for the reference's step: a converged
+#             reference must never go backwards (scripts/hunt5.py: the fifth hunt's grids)
 set -euo pipefail
 build=build
 jobs=$(nproc)
 while (($#)); do
   case "$1" in
     -j) jobs="$2"; shift 2 ;;
-    -h|--help) sed -n 2,32p "$0"; exit 0 ;;
+    -h|--help) sed -n 2,34p "$0"; exit 0 ;;
     *) build="$1"; shift ;;
   esac
 done
@@ -817,6 +819,37 @@ lifetime = 5.0
 destroy_on_collision = false
 """)
 
+# stiffdrag: a ball thrown at 50-200 m/s against quadratic drag k2 = 2-10 towards a wall and a
+# floor. Drag never reverses a body: a reference that says it converged must keep x >= 0
+# (at k |v| dt / m = 4.2 it went 3 m backwards at dt/8 and dt/4 alike, "converged" to 0 m).
+for k in [2.0, 10.0]:
+    for v0 in [50.0, 200.0]:
+        n = f"stiffdrag_{int(k)}_{int(v0)}"
+        write(n, f"""name = "{n}"
+duration = 3.0
+dt = "1/60"
+engines = ["core"]
+[world]
+gravity = [0.0, -9.81]
+[[bodies]]
+name = "b"
+radius = 0.1
+position = [0.0, 1.0]
+velocity = [{v0!r}, {0.3 * v0!r}]
+restitution = 0.9
+drag_quadratic = {k!r}
+[[walls]]
+name = "wall"
+from = [3.0, -1.0]
+to = [3.0, 20.0]
+restitution = 0.9
+[[walls]]
+name = "floor"
+from = [-200.0, 0.0]
+to = [3.0, 0.0]
+restitution = 0.9
+""")
+
 import json
 json.dump(truth, open(os.path.join(out, "..", "truth.json"), "w"))
 EOF
@@ -944,6 +977,14 @@ for r in runs:
             found.append(f"WRONG GREEN {sc} {eng}: {len(out)} particles ended outside their closed box, status {r['status']}")
         if eng == "core":
             found.append(f"CORE WRONG {sc}: {len(out)} particles left their closed box")
+for sc, ref in refs.items():
+    if not sc.startswith("stiffdrag_") or not ref.get("converged"):
+        continue
+    path = os.path.join(sys.argv[2], "..", "out", "series", sc, "reference.csv")
+    rows = [l.strip().split(",") for l in open(path) if l.strip()]
+    xs = [float(r[rows[0].index("x_b")]) for r in rows[1:]]
+    if min(xs) < 0.0:
+        found.append(f"CORE WRONG {sc}: the converged reference went {-min(xs):.3g} m backwards against drag")
 for eng, by_width in drift.items():
     base = by_width.get(1)
     for w, d in sorted(by_width.items()):

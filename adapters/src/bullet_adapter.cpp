@@ -69,7 +69,8 @@ std::vector<OptionSpec> bullet_options() {
        "Continuous collision: a sphere moving further than its radius in a step is swept "
        "(setCcdMotionThreshold = setCcdSweptSphereRadius = radius); needs contact_processing_threshold > 0, "
        "since its predictive contacts are points before touching. Off: a bounce loses energy with it on "
-       "(engines.md: 69%; here a 10 m drop's apex fell to 9.15 m)."},
+       "(engines.md: 69%; here a 10 m drop's apex fell to 9.15 m).",
+       OptionRange::any(), "contact_processing_threshold", OptionRange::above(0)},
       {"restitution_threshold", 0.0, {},
        "Approach speed (m/s) below which a contact does not bounce (m_restitutionVelocityThreshold). "
        "Bullet's own default is 0.2 m/s; physval's 0 keeps an elastic scene elastic.",

@@ -360,6 +360,24 @@ Reference make_reference(const Scene& scene, const RunOptions& options) {
   int refine = 8;
   const double body_steps = static_cast<double>(std::max<std::size_t>(1, scene.bodies.size())) * scene.steps();
   while (refine > 2 && body_steps * refine > 4e7) refine /= 2;
+  // Neither run may pass the most steps a run takes (Scene::kMaxSteps): beyond it the
+  // step count saturates and the run would end in one giant last step (a scene of 6e8 steps
+  // had its fine reference of 1.2e9 steps cut to 1e9 and a last step of 2e8 dt).
+  const double scene_steps = static_cast<double>(scene.steps());
+  while (refine > 2 && scene_steps * refine > Scene::kMaxSteps) refine /= 2;
+  if (scene_steps * refine > Scene::kMaxSteps) {
+    ref.reason = "the reference would need " + show(scene_steps * refine) + " steps at dt/" + std::to_string(refine) +
+                 ", more than a run takes (" + show(static_cast<double>(Scene::kMaxSteps)) + ")";
+    return ref;
+  }
+  // And its steps must be normal numbers (a dt of 5e-324 s halves to 0: the reference's
+  // run never advanced and filled the memory; the loader refuses such a dt, this guards
+  // the rest).
+  if (!(scene.dt / refine >= std::numeric_limits<double>::min())) {
+    ref.reason = "the reference's step dt/" + std::to_string(refine) + " = " + show(scene.dt / refine) +
+                 " s is below the smallest normal double";
+    return ref;
+  }
   const long every = sample_every(scene, options.max_sample_states);
   auto variant = [&](int factor) {
     Scene s = scene;
@@ -402,6 +420,36 @@ Reference make_reference(const Scene& scene, const RunOptions& options) {
   }
   ref.available = true;
   const Scales scales = characteristic_scales(scene, &fine_run.series);
+  // Drag too stiff for the reference's step: k dt / m above 1 (k = k1 + k2 |v - wind|)
+  // takes a body's velocity past zero within one explicit step. At dt/8 a ball of 1 kg at
+  // 200 m/s with k2 = 10 (k dt / m = 4.2) went 3 m backwards in one step, the same at dt/4,
+  // so the two runs agreed to 0 m and the reference was "converged", 3.6 m from the
+  // truth (the ball stops 0.62 m on). Each body's speed is bounded by its start and by
+  // the largest kinetic energy of the run (all of it in that body).
+  {
+    double kinetic_max = 0.0;
+    for (const Totals& t : fine_run.series.totals) kinetic_max = std::max(kinetic_max, t.kinetic);
+    double worst = 0.0;
+    std::string body;
+    for (const BodyDef& b : scene.bodies) {
+      if (b.is_static || !(b.drag_linear > 0.0 || b.drag_quadratic > 0.0)) continue;
+      const double speed = std::max(length(b.velocity), std::sqrt(2.0 * kinetic_max / b.mass)) + length(scene.world.wind);
+      const double stiff = fine.dt * (b.drag_linear + b.drag_quadratic * speed) / b.mass;
+      if (stiff > worst) {
+        worst = stiff;
+        body = b.name;
+      }
+    }
+    if (worst > 1.0) {
+      ref.converged = false;
+      ref.convergence_error = std::numeric_limits<double>::infinity();
+      ref.reason = "not converged: drag is too stiff for the reference's step: body " + body + "'s k dt / m reaches " +
+                   fmt(worst) + " > 1 at dt/" + std::to_string(refine) + " (k = k1 + k2 |v - wind|): one step can take " +
+                   "its velocity past zero";
+      ref.run = std::move(fine_run);
+      return ref;
+    }
+  }
   const SeriesDivergence d = series_divergence(fine_run.series, coarse_run.series, same_time(fine.dt, coarse.dt), scales,
                                                1e300, scene.bodies.size());
   ref.convergence_error = d.position_max.value_or(0.0);

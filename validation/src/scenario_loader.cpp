@@ -667,6 +667,36 @@ void read_engine_options(Context& ctx, const toml::table& t, const EngineInfo& i
       }
     }
   }
+  // Options that need another option in a range (Bullet's ccd needs a positive
+  // contact_processing_threshold): the engine cannot run the scene otherwise, so it is bad
+  // input here, not a run error later. Judged on the values the run would use (given or default).
+  for (const OptionSpec& spec : info.options) {
+    if (spec.needs_key.empty() || spec.default_value.index() != 0) continue;
+    auto effective = [&](const std::string& key) -> const OptionValue* {
+      if (auto it = out.find(key); it != out.end()) return &it->second;
+      for (const OptionSpec& o : info.options) {
+        if (o.key == key) return &o.default_value;
+      }
+      return nullptr;
+    };
+    const OptionValue* on = effective(spec.key);
+    if (on == nullptr || on->index() != 0 || !std::get<bool>(*on)) continue;
+    const OptionValue* need = effective(spec.needs_key);
+    double v = std::numeric_limits<double>::quiet_NaN();
+    if (need != nullptr && need->index() == 1) v = static_cast<double>(std::get<std::int64_t>(*need));
+    if (need != nullptr && need->index() == 2) v = std::get<double>(*need);
+    if (need != nullptr && (need->index() == 1 || need->index() == 2) && spec.needs_range.contains(v)) continue;
+    const std::string got = need == nullptr ? std::string("nothing") : option_value_to_string(*need);
+    const bool given = out.count(spec.needs_key) != 0;
+    const std::string msg = spec.key + " = true needs " + info.name + "." + spec.needs_key + " " +
+                            spec.needs_range.describe() + ", and it is " + got +
+                            (given ? std::string() : std::string(" (its default)"));
+    if (const toml::node* n = given ? r.node(spec.needs_key) : r.node(spec.key)) {
+      r.error_at(*n, given ? spec.needs_key : spec.key, msg);
+    } else {
+      r.error_here(spec.key, msg);
+    }
+  }
 }
 
 // Checks that need the whole scene: unique names, references by name.

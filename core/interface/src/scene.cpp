@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace physval {
 
@@ -13,8 +14,16 @@ int Scene::steps() const {
 }
 
 std::string scene_steps_error(const Scene& s) {
+  char text[260];
+  // The reference steps at down to dt/16: a dt whose 16th is not a normal double (a
+  // subnormal dt such as 5e-324 s, whose halves round to 0) is a step nothing can take.
+  if (s.dt > 0.0 && !(s.dt / 16.0 >= std::numeric_limits<double>::min())) {
+    std::snprintf(text, sizeof text, "dt = %.6g s is too small: the reference steps at dt/16, below the smallest "
+                  "normal double (%.6g); use dt >= %.6g", s.dt, std::numeric_limits<double>::min(),
+                  16.0 * std::numeric_limits<double>::min());
+    return text;
+  }
   if (s.steps() <= Scene::kMaxSteps) return {};
-  char text[200];
   std::snprintf(text, sizeof text, "duration / dt = %.6g / %.6g = %.4g steps, more than physval runs (%d); "
                 "shorten the duration or enlarge dt", s.duration, s.dt, s.duration / s.dt, Scene::kMaxSteps);
   return text;

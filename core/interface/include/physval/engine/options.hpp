@@ -35,6 +35,13 @@ struct OptionSpec {
   std::vector<std::string> choices;    // for string options: the allowed values
   std::string doc;
   OptionRange range = OptionRange::any();   // numeric options: the values accepted
+  // A boolean option that only works with another option in a range (Bullet's `ccd` needs
+  // `contact_processing_threshold` > 0): when this option is true (given or by default),
+  // the option `needs_key` (given or by default) must lie in `needs_range`. The loader
+  // refuses a scene that breaks it (file:line:col and key, exit 2), as it refuses a value
+  // out of its own range: the engine cannot run it, and that is bad input, not a run error.
+  std::string needs_key{};
+  OptionRange needs_range = OptionRange::any();
 };
 
 class OptionReader {
