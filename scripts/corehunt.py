@@ -60,7 +60,7 @@ def bisect(fn, a, b, it=200):
     return 0.5 * (a + b)
 
 
-def first_root(fn, t0, t1, n=4000):
+def first_root(fn, t0, t1, n=600):
     """The earliest time in (t0, t1] where fn (positive at t0+) becomes <= 0."""
     prev = t0
     for k in range(1, n + 1):
@@ -291,7 +291,7 @@ def family_slopes():
                 if abs(math.tan(th) - mus) < 1e-6:
                     continue
                 for v0 in (0.0, 1.5, -2.0):
-                    for segs in (1, 3):
+                    for segs in (1, 3, 2):
                         idx += 1
                         if (idx % 2) and segs == 3:
                             continue
@@ -309,7 +309,9 @@ def family_slopes():
                         # pieces from -L to +L along d (drawn from the upper end down: the
                         # left of the point order is the side away from... a wall is two-sided)
                         cuts = [-L + 2 * L * k / segs for k in range(segs + 1)]
-                        if segs > 1:
+                        if segs == 2:
+                            cuts[1] = 0.5  # a junction the ball slides over (downhill)
+                        if segs == 3:
                             cuts[1] = -0.37 * L if segs == 3 else cuts[1]
                             cuts[2] = 0.0 if segs == 3 else cuts[2]  # a junction under the ball
                         mats = ""
@@ -694,6 +696,7 @@ def main():
     physval, work = args[0], args[1]
     jobs = "2"
     fams = []
+    judge_only = "--judge-only" in args
     i = 2
     while i < len(args):
         if args[i] == "-j":
@@ -717,7 +720,8 @@ def main():
             with open(os.path.join(d, c.name + ".toml"), "w") as fh:
                 fh.write(c.toml)
         out = os.path.join(work, fam, "out")
-        subprocess.run([physval, "run", d, "--engines", "core", "--out", out, "-j", jobs, "--no-cache", "--quiet"],
+        if not judge_only:
+          subprocess.run([physval, "run", d, "--engines", "core", "--out", out, "-j", jobs, "--no-cache", "--quiet"],
                        stdout=subprocess.DEVNULL)
         with open(os.path.join(out, "results.json")) as fh:
             res = json.load(fh)

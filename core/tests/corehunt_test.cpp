@@ -48,5 +48,81 @@ TEST(CoreHunt, SqueezedBilliardCollapsesWithoutGainingEnergy) {
   }
 }
 
+// A circle (r 0.1, e 0) started touching a slope drawn in two collinear pieces, exactly
+// over their junction (its centre a few 1e-16 m past the upper piece's end), at rest or
+// moving down, under gravity; both pieces with mu_s, mu_k. Closed form: it stays iff
+// tan(angle) <= mu_s, else s(t) = v0 t + g (sin - mu_k cos) t^2 / 2 (or it stops at
+// v0 / |a| when a < 0). It met the upper piece's end cap, which core does not settle on,
+// and micro-bounced off it, sliding with flights free of friction: up to 7.6e-4 m off at
+// 1.5 s with status ok (3 of these 70 cases), and 26 reached the event cap at t = 0.
+// Returns how many runs reached the event cap (each such run stops as diverged: honest);
+// every other run must meet the closed form.
+int junction_start_grid() {
+  constexpr double kG = 9.8, kR = 0.1, kT = 1.5, kDt = 1.0 / 60.0;
+  int cases = 0, capped = 0;
+  for (const double deg : {10.0, 30.0, 45.0, 53.0, 60.0, 70.0, 89.0}) {
+    for (const auto& [mu_s, mu_k] : {std::pair{0.0, 0.0}, std::pair{0.1, 0.1}, std::pair{0.577, 0.2885},
+                                     std::pair{1.0, 0.5}, std::pair{3.0, 1.5}}) {
+      for (const double v0 : {0.0, 1.5}) {
+        const double th = deg * std::acos(-1.0) / 180.0;
+        const Vec2 d{std::cos(th), -std::sin(th)}, n{std::sin(th), std::cos(th)};
+        const double L = 20.0;
+        Scene s = scene_of({circle("ball", kR * n, v0 * d, kR, 1.0, 0.0)},
+                           {wall("upper", (-L) * d, Vec2{0.0, 0.0}, 0.0, mu_k, mu_s),
+                            wall("lower", Vec2{0.0, 0.0}, L * d, 0.0, mu_k, mu_s)},
+                           {0.0, -kG});
+        s.materials = {pair_friction("ball", "upper", 0.0), pair_friction("ball", "lower", 0.0)};
+        for (MaterialOverride& m : s.materials) {
+          m.friction = mu_k;
+          m.static_friction = mu_s;
+        }
+        const double a = kG * (std::sin(th) - mu_k * std::cos(th));
+        double sT = 0.0, vT = 0.0;
+        if (v0 == 0.0) {
+          if (std::tan(th) > mu_s) {
+            sT = 0.5 * a * kT * kT;
+            vT = a * kT;
+          }
+        } else if (a >= 0.0 || v0 / -a >= kT) {
+          sT = v0 * kT + 0.5 * a * kT * kT;
+          vT = v0 + a * kT;
+        } else {
+          sT = v0 * v0 / (-2.0 * a);
+        }
+        SCOPED_TRACE("angle " + std::to_string(deg) + " mu_s " + std::to_string(mu_s) + " v0 " + std::to_string(v0));
+        ++cases;
+        Sim sim(s);
+        sim.run_until(kT, kDt);
+        EXPECT_EQ(sim.engine.broken_guarantee(), "");
+        if (!sim.engine.limits_hit().empty()) {
+          ++capped;
+          continue;
+        }
+        const BodyState b = sim.state("ball");
+        const Vec2 want = sT * d + kR * n;
+        EXPECT_NEAR(b.position.x, want.x, 1e-7 * (1.0 + std::fabs(sT)));
+        EXPECT_NEAR(b.position.y, want.y, 1e-7 * (1.0 + std::fabs(sT)));
+        EXPECT_NEAR(dot(b.velocity, d), vT, 1e-7 * (1.0 + std::fabs(vT)));
+      }
+    }
+  }
+  EXPECT_EQ(cases, 70);
+  return capped;
+}
+
+// Never ok off the closed form; and fewer cap hits than the 26 before the junction
+// handover (now 10 here; the physval runs of the same grid: 14).
+TEST(CoreHunt, ABodyStartedOnAJunctionOfASlopeIsNeverOkOffTheClosedForm) {
+  EXPECT_LE(junction_start_grid(), 12);
+}
+
+// Open: the rest reach the event cap at t = 0 (a ball supported on the lower piece meets
+// the upper piece's face at its very end again and again at t = 0; e.g. 10 degrees,
+// frictionless, at rest). A collinear neighbour of the support face at a junction should
+// not be an impact candidate while the body rests on the support.
+TEST(CoreHunt, DISABLED_ABodyStartedOnAJunctionOfASlopeNeverReachesTheCap) {
+  EXPECT_EQ(junction_start_grid(), 0);
+}
+
 }  // namespace
 }  // namespace physval::test
