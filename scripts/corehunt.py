@@ -203,7 +203,9 @@ def family_drag():
             idx += 1
             m, r, e, W = 0.45, 0.11, 0.8, 50.0
             x0, v0 = (0.0, 2.0), (1.0, 0.0)
-            res = linear_drag_path(x0, v0, m, k, True, (0.0, 0.0), W, r, e, 10.0)
+            res = linear_drag_path(x0, v0, m, k, True, (0.0, 0.0), W, r, e, 1.5)
+            if res is None or not res[0]:
+                continue
             t1 = res[0][0][1]
             dt = t1 / n
             T = 1.5 * t1
