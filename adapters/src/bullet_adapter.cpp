@@ -156,6 +156,7 @@ class BulletEngine final : public Engine {
   std::size_t body_count() const override { return bodies_.size(); }
   BodyMeta body_meta(std::size_t i) const override;
   void read_states(std::vector<BodyState>& out) const override;
+  void read_motion(std::vector<BodyState>& out) const override;
   const std::vector<ContactEvent>& contacts() const override { return contacts_; }
   std::vector<Setting> settings() const override;
   std::vector<std::string> limits_hit() const override { return limits_.lines(); }
@@ -546,6 +547,16 @@ void BulletEngine::check_limits(double dt) {
 }
 
 BodyMeta BulletEngine::body_meta(std::size_t i) const { return objects_->body_meta(i); }
+
+void BulletEngine::read_motion(std::vector<BodyState>& out) const {
+  out.resize(bodies_.size());
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    const btRigidBody& b = *bodies_[i];
+    out[i].position = from_bt(b.getWorldTransform().getOrigin());
+    out[i].velocity = from_bt(b.getLinearVelocity());
+    out[i].alive = static_cast<bool>(alive_[i]);
+  }
+}
 
 void BulletEngine::read_states(std::vector<BodyState>& out) const {
   out.resize(bodies_.size());

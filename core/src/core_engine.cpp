@@ -93,6 +93,14 @@ void CoreEngine::step(double dt) {
   if (!w.emitters.empty()) core_detail::finish_particles(w, ctx);
 
   w.time = ctx.t0 + dt;
+  // Holds made inside a step are judged at the next step's start (apply_supports), once
+  // the supports are settled again. The run's last step has no next one: its holds are
+  // judged at its end, so a hold made there is not `ok` unjudged (the same verdict and time
+  // as a longer run gives at the next step's start).
+  const double end_tol = 1e-9 * dt;
+  if (exact && !w.braced_holds.empty() && ctx.t0 < w.end_time - end_tol && w.time >= w.end_time - end_tol) {
+    core_detail::judge_braced_holds(w);
+  }
 }
 
 double CoreEngine::time() const { return world_->time; }

@@ -702,7 +702,187 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   // law 0: Newton's law at the normals, friction against the tangential velocity after
   // the impact; law 1: Moreau's law, friction against w_t+ + e w_t- (the tangential
   // velocity restituted with the contact's own e); law 2: every normal inelastic.
+  // A friction set projected Jacobi has not brought to round-off in max_iter sweeps (its
+  // rate is ~ the mass ratio of the bodies a contact couples: a 1000 kg ball stopped by a
+  // 1 kg one against a wall kept 0.2% of its speed after 20,000 sweeps, and came back at
+  // a micro-bounce's speed) is solved exactly: the contact states Jacobi reached (each
+  // normal on where its impulse is > 0; a tangent sticking inside its cone, else sliding
+  // at mu_k p_n against the sign it reached) give a square linear system on the Delassus
+  // matrix, solved by Gauss elimination with partial pivoting; its answer is kept if it
+  // meets every condition of the law to round-off (impulses >= 0 and within the cones,
+  // every contact at or above its target, every active one at it, sliders sliding the
+  // way their friction resists); else Jacobi's answer stands. Only sets Jacobi cannot
+  // finish come here. (Trying every combination of states when Jacobi's fail was tried:
+  // with friction the law can have several solutions, and in hard/notch_drop_friction the
+  // first combination found let the resting ball creep 6e-7 m where Jacobi's holds it.)
+  thread_local std::vector<double> pf_M, pf_G, pf_x, pf_p;
+  thread_local std::vector<std::int8_t> pf_state;   // per contact: 0 off, 1 stick/on, 2 slide +, 3 slide -
+  thread_local std::vector<std::size_t> pf_nrow, pf_trow;
+  const auto polish_friction = [&](int law) {
+    if (R > 24) return;
+    pf_M.assign(R * R, 0.0);
+    for (std::size_t k = 0; k < R; ++k) {
+      for (std::size_t l = 0; l < R; ++l) {
+        const double dd = dot(rows[k].d, rows[l].d);
+        double v = 0.0;
+        if (rows[k].a == rows[l].a) v += inv(rows[k].a) * dd;
+        if (rows[k].b == rows[l].b) v += inv(rows[k].b) * dd;
+        if (rows[k].a == rows[l].b) v -= inv(rows[k].a) * dd;
+        if (rows[k].b == rows[l].a) v -= inv(rows[k].b) * dd;
+        pf_M[k * R + l] = v;
+      }
+    }
+    pf_nrow.assign(K, 0);
+    pf_trow.assign(K, R);
+    for (std::size_t k = 0; k < R; ++k) {
+      if (rows[k].tangent) pf_trow[rows[k].contact] = k;
+      else pf_nrow[rows[k].contact] = k;
+    }
+    const auto ntarget = [&](std::size_t c) { return law == 2 ? 0.0 : contacts[c].target; };
+    // the tangent's w_t+ when it sticks: 0, or -e w_t- under Moreau's law
+    const auto ttarget = [&](std::size_t c) { return law == 1 ? -contacts[c].e * w0[pf_trow[c]] : 0.0; };
+    // The unknowns in an order fixed by the geometry (a contact's place: the midpoint of its
+    // bodies' centres, or its body's centre on a face, keyed (y, |x|), then |n|'s components),
+    // so that the elimination's round-off, and so the answer, is the same for every
+    // numbering of the bodies and mirrored in a mirrored scene.
+    thread_local std::vector<std::size_t> pf_order;
+    pf_order.resize(K);
+    for (std::size_t c = 0; c < K; ++c) pf_order[c] = c;
+    const auto place = [&](std::size_t c) {
+      const Contact& x = contacts[c];
+      const Vec2 m = (x.a & kSegmentContact) ? w.pos[x.b] : 0.5 * (w.pos[x.a] + w.pos[x.b]);
+      return std::tuple<double, double, double, double>{m.y, std::fabs(m.x), std::fabs(x.n.y), std::fabs(x.n.x)};
+    };
+    std::stable_sort(pf_order.begin(), pf_order.end(), [&](std::size_t x, std::size_t y) { return place(x) < place(y); });
+    const auto attempt = [&]() -> bool {
+      // unknowns: the normal impulse of each contact on, the tangent one of each sticking
+      std::vector<std::size_t> eq;   // the row each unknown's equation is on
+      for (std::size_t c : pf_order) {
+        if (pf_state[c] == 0) continue;
+        eq.push_back(pf_nrow[c]);
+        if (pf_state[c] == 1 && pf_trow[c] < R) eq.push_back(pf_trow[c]);
+      }
+      const std::size_t n = eq.size();
+      if (n == 0) return false;
+      // column of unknown u: the velocity change per unit of it, on every row
+      pf_G.assign(n * (n + 1), 0.0);
+      std::vector<std::vector<double>> col(n, std::vector<double>(R, 0.0));
+      {
+        std::size_t u = 0;
+        for (std::size_t c : pf_order) {
+          if (pf_state[c] == 0) continue;
+          const std::size_t kn = pf_nrow[c], kt = pf_trow[c];
+          for (std::size_t r = 0; r < R; ++r) col[u][r] = pf_M[r * R + kn];
+          if (pf_state[c] >= 2 && kt < R) {
+            const double sgn = pf_state[c] == 2 ? 1.0 : -1.0;
+            for (std::size_t r = 0; r < R; ++r) col[u][r] += sgn * contacts[c].mu_k * pf_M[r * R + kt];
+          }
+          ++u;
+          if (pf_state[c] == 1 && kt < R) {
+            for (std::size_t r = 0; r < R; ++r) col[u][r] = pf_M[r * R + kt];
+            ++u;
+          }
+        }
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t j = 0; j < n; ++j) pf_G[i * (n + 1) + j] = col[j][eq[i]];
+        const std::size_t r = eq[i];
+        const double tgt = rows[r].tangent ? ttarget(rows[r].contact) : ntarget(rows[r].contact);
+        pf_G[i * (n + 1) + n] = tgt - w0[r];
+      }
+      for (std::size_t c = 0; c < n; ++c) {
+        std::size_t piv = c;
+        for (std::size_t r = c + 1; r < n; ++r) {
+          if (std::fabs(pf_G[r * (n + 1) + c]) > std::fabs(pf_G[piv * (n + 1) + c])) piv = r;
+        }
+        if (!(std::fabs(pf_G[piv * (n + 1) + c]) > 1e-300)) return false;
+        for (std::size_t j = 0; j <= n; ++j) std::swap(pf_G[c * (n + 1) + j], pf_G[piv * (n + 1) + j]);
+        for (std::size_t r = 0; r < n; ++r) {
+          if (r == c) continue;
+          const double f = pf_G[r * (n + 1) + c] / pf_G[c * (n + 1) + c];
+          if (f == 0.0) continue;
+          for (std::size_t j = c; j <= n; ++j) pf_G[r * (n + 1) + j] -= f * pf_G[c * (n + 1) + j];
+        }
+      }
+      pf_x.assign(n, 0.0);
+      for (std::size_t i = 0; i < n; ++i) pf_x[i] = pf_G[i * (n + 1) + n] / pf_G[i * (n + 1) + i];
+      pf_p.assign(R, 0.0);
+      {
+        std::size_t u = 0;
+        for (std::size_t c : pf_order) {
+          if (pf_state[c] == 0) continue;
+          const double pn = pf_x[u++];
+          if (!(pn >= 0.0) || !std::isfinite(pn)) return false;
+          pf_p[pf_nrow[c]] = pn;
+          if (pf_trow[c] < R) {
+            if (pf_state[c] == 1) {
+              const double pt = pf_x[u++];
+              if (!(std::fabs(pt) <= contacts[c].mu_s * pn * (1.0 + 1e-12))) return false;
+              pf_p[pf_trow[c]] = pt;
+            } else {
+              pf_p[pf_trow[c]] = (pf_state[c] == 2 ? 1.0 : -1.0) * contacts[c].mu_k * pn;
+            }
+          }
+        }
+      }
+      // the law's conditions, to round-off of the speeds
+      for (std::size_t c = 0; c < K; ++c) {
+        const std::size_t kn = pf_nrow[c], kt = pf_trow[c];
+        const auto wplus = [&](std::size_t r) {
+          double v = w0[r];
+          for (std::size_t l = 0; l < R; ++l) v += pf_M[r * R + l] * pf_p[l];
+          return v;
+        };
+        double scale = contacts[c].vscale + std::fabs(ntarget(c));
+        for (std::size_t l = 0; l < R; ++l) scale += std::fabs(pf_M[kn * R + l] * pf_p[l]);
+        const double tol = kGapUlps * kEps * scale;
+        const double wn = wplus(kn);
+        if (!std::isfinite(wn) || wn < ntarget(c) - tol) return false;
+        if (pf_state[c] != 0 && wn > ntarget(c) + tol) return false;
+        if (kt < R && pf_state[c] >= 2) {
+          // sliding: w_t+ (less its target) against the impulse's sign, or at rest
+          const double wt = wplus(kt) - ttarget(c);
+          if ((pf_state[c] == 2 && wt > tol) || (pf_state[c] == 3 && wt < -tol)) return false;
+        }
+      }
+      for (std::size_t k = 0; k < R; ++k) p[k] = pf_p[k];
+      return true;
+    };
+    // Jacobi's states first.
+    pf_state.assign(K, 0);
+    for (std::size_t c = 0; c < K; ++c) {
+      const double pn = p[pf_nrow[c]];
+      if (!(pn > 0.0)) continue;
+      pf_state[c] = 1;
+      if (pf_trow[c] < R) {
+        const double pt = p[pf_trow[c]];
+        if (std::fabs(pt) >= contacts[c].mu_s * pn * (1.0 - 1e-9)) pf_state[c] = pt > 0.0 ? 2 : 3;
+      }
+    }
+    // Jacobi's velocities already meet them to round-off (its impulses drifting along a
+    // family of solutions, as in a ball wedged with friction, whose velocities are
+    // settled): its answer stands, the same to the last bit for every numbering (the
+    // elimination's round-off follows the row order: the notch with friction moved by
+    // 2e-8 m between numberings when such sets were solved again).
+    bool settled = true;
+    for (std::size_t c = 0; c < K && settled; ++c) {
+      const std::size_t kn = pf_nrow[c], kt = pf_trow[c];
+      const auto wplus = [&](std::size_t r) {
+        double v = w0[r];
+        for (std::size_t l = 0; l < R; ++l) v += pf_M[r * R + l] * p[l];
+        return v;
+      };
+      double scale = contacts[c].vscale + std::fabs(ntarget(c));
+      for (std::size_t l = 0; l < R; ++l) scale += std::fabs(pf_M[kn * R + l] * p[l]);
+      const double tol = kGapUlps * kEps * scale;
+      const double wn = wplus(kn);
+      if (wn < ntarget(c) - tol || (pf_state[c] != 0 && wn > ntarget(c) + tol)) settled = false;
+      if (settled && kt < R && pf_state[c] == 1 && std::fabs(wplus(kt) - ttarget(c)) > tol) settled = false;
+    }
+    if (!settled) attempt();
+  };
   const auto friction_solve = [&](int law) {
+    bool converged = false;
     p.assign(R, 0.0);
     dv.assign(bodies.size(), Vec2{});
     pmax = 0.0;
@@ -811,7 +991,10 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       std::swap(pc, pq);
       swapped = !swapped;
       // The velocity changes of the last sweep are not needed: recompute_dv() below.
-      if (change <= stop * pm) break;
+      if (change <= stop * pm) {
+        converged = true;
+        break;
+      }
       if (singles) {
         // No group of equal keys: each term is a group of one (the branch below, g == 1).
         for (const SweepBody& bt : sweep_body) {
@@ -864,6 +1047,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     }
     pmax = pm;
     if (swapped) p.swap(pnew);
+    if (!converged) polish_friction(law);
     // A contact whose friction could not stop it slides: kinetic friction, mu_k p_n.
     for (std::size_t k = 0; k < R; ++k) {
       const Row& rk = rows[k];
@@ -1140,13 +1324,34 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   // Snapping at 1024 ulps (~1e-13 of it) instead changed the 50-circle pile at e 0.9 enough
   // to end in a step that gained 0.15 J elsewhere, not understood yet (README, core,
   // Several supports).
+  double set_vscale = 0.0;
+  for (const Contact& c : contacts) set_vscale = std::max(set_vscale, c.vscale);
   for (std::size_t s = 0; s < bodies.size(); ++s) {
     if (!(inv(bodies[s]) > 0.0)) continue;
     const Vec2 before = w.vel[bodies[s]];
     const Vec2 after = before + dv[s];
+    // In a friction set, a velocity within 1024 ulps of the speeds of the contacts that gave
+    // the body an impulse (p > 0) is a leftover of the solve, 0: a ball at rest against a
+    // wall, struck at 2 m/s at e = 0, kept 1.6e-15 m/s into the wall; sliding, its kinetic
+    // friction read as pressing the striker (2.7e-15 m/s) into it, and the next impact at
+    // the same instant was a micro-bounce that sent the striker back at half the rest speed
+    // for ever (hunt: frictionless_into_row_at_wall). Not in frictionless sets: it moved the
+    // frictionless 10-circle pile (e 0, seed 1) onto a path whose unjustified hold core
+    // reports without a certificate. (Only leftovers pressing a body into an active contact
+    // was tried: a 1000 kg striker stopped through two 1 kg balls then micro-bounced back.)
+    double local = 0.0;
+    if (friction && inf_norm(after) <= kGapUlps * kEps * set_vscale) {
+      for (std::uint32_t f = term_start[s]; f < term_start[s + 1]; ++f) {
+        const Row& rk = rows[term_row[f]];
+        if (rk.tangent) continue;
+        const Contact& c = contacts[rk.contact];
+        if (c.p > 0.0) local = std::max(local, c.vscale);
+      }
+    }
     const bool residual = (inf_norm(after) < std::numeric_limits<double>::min() &&
                            inf_norm(after) <= kGapUlps * kEps * inf_norm(before)) ||
-                          inf_norm(after) <= 4.0 * kEps * inf_norm(before);
+                          inf_norm(after) <= 4.0 * kEps * inf_norm(before) ||
+                          inf_norm(after) <= kGapUlps * kEps * local;
     w.vel[bodies[s]] = residual ? Vec2{} : after;
   }
   w.stats.impacts += static_cast<std::int64_t>(K) - 1;

@@ -152,6 +152,7 @@ struct World {
   bool any_forces = false;       // acc / apath exist (something accelerates a body)
   bool varying_forces = false;   // drag, thrust or Newtonian: a depends on the state
   double time = 0.0;
+  double end_time = 0.0;         // the scene's duration: its run's last step ends there
   double length_scale = 1.0;     // extent of the scene, for round-off tolerances
   double rest_factor = 1.0 / 16.0;   // auto rest speed = rest_factor |a_n| dt
 
@@ -358,6 +359,7 @@ void compute_accelerations(World& w, std::span<const Vec2> pos, std::span<const 
 // gravity, which needs every body) at velocity vel (accelerations.cpp).
 Vec2 body_acceleration(const World& w, std::uint32_t i, Vec2 vel);
 void apply_supports(World& w, const StepContext& ctx);          // resting_contact.cpp
+void judge_braced_holds(World& w);                              // resting_contact.cpp
 void begin_paths(World& w, const StepContext& ctx);             // integrators.cpp
 void collide_exact(World& w, StepContext& ctx);                 // exact_collisions.cpp
 void collide_lecture(World& w, StepContext& ctx, double t_from);   // lecture_collisions.cpp

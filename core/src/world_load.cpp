@@ -318,6 +318,7 @@ void load_world(World& w, const Scene& scene) {
   w.contacts.reserve(std::max<std::size_t>(64, cap / 4));
   w.passing.reserve(16);
   w.time = 0.0;
+  w.end_time = scene.duration;
 }
 
 std::size_t World::memory_bytes() const {

@@ -74,6 +74,46 @@ TEST(CoreBraced, AFrictionlessPyramidIsHeldIffItsBracesReachAWall) {
   }
 }
 
+// A hold made inside the run's last step is judged too. The same free-braced pyramid, its top
+// dropped from 1e-6 m (it lands at 4.5e-4 s, at 4.4 mm/s, slower than the collapse speed, and
+// is held on the bottom balls inside the first step). Holds made inside a step are judged at
+// the next step's start; a run of one step had none, and its hold was never judged: `ok`.
+// Now the last step's holds are judged at its end: a run of one step and a run of three give
+// the same report at the same time (t = 1/60 s), and with the right wall (held) neither
+// reports anything.
+TEST(CoreBraced, AHoldMadeInTheLastStepIsJudged) {
+  const double s3 = std::sqrt(3.0);
+  const double dt = 1.0 / 60.0;
+  for (bool right_wall : {false, true}) {
+    for (int steps : {1, 3}) {
+      SCOPED_TRACE(std::to_string(steps) + " steps" + (right_wall ? ", right wall" : ", free brace"));
+      std::vector<BodyDef> b = {circle("left", {-r, r}, {}, r, 1.0, 0.0), circle("right", {r, r}, {}, r, 1.0, 0.0),
+                                circle("brace", {3.0 * r, r}, {}, r, 1.0, 0.0),
+                                circle("top", {0.0, r + s3 * r + 1e-6}, {}, r, 1.0, 0.0)};
+      std::vector<WallDef> walls = {wall("floor", {-50.0, 0.0}, {50.0, 0.0}, 0.0, 0.0),
+                                    wall("lw", {-2.0 * r, 3.0}, {-2.0 * r, 0.0}, 0.0, 0.0)};
+      if (right_wall) walls.push_back(wall("rw", {4.0 * r, 0.0}, {4.0 * r, 3.0}, 0.0, 0.0));
+      Scene sc = scene_of(b, walls, {0.0, -g});
+      sc.duration = steps * dt;
+      sc.dt = dt;
+      Sim sim(sc);
+      std::string report;
+      for (int k = 0; k < steps && report.empty(); ++k) {
+        sim.step(dt);
+        report = sim.engine.broken_guarantee();
+        // the top is held on the bottom balls from the first step on
+        EXPECT_EQ(sim.state("top").velocity, (Vec2{0.0, 0.0}));
+      }
+      if (right_wall) {
+        EXPECT_TRUE(report.empty()) << report;
+      } else {
+        EXPECT_NE(report.find("'top' at t = 0.0166667 s"), std::string::npos) << report;
+        EXPECT_NE(report.find("cannot hold it"), std::string::npos) << report;
+      }
+    }
+  }
+}
+
 // Two layers between walls: n bottom balls on the floor, centres d = 1.2 m apart (not
 // touching), and n - 1 top balls each in the pocket of two neighbours (contact normals at
 // theta to the vertical, sin theta = d / 4r = 0.6). Balls frictionless, floor friction mu on

@@ -189,6 +189,7 @@ void record_known_failures(const SuiteResult& result, double margin) {
 
 int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, const std::string& baseline_path,
                 double baseline_factor, bool report, double record_known = 0.0) {
+  discard_earlier_junit(junit);   // a run that stops before writing it leaves none, not the last one
   RunOptions options;
   if (!o.dt.empty()) {
     options.dt = parse_seconds(o.dt);
@@ -275,7 +276,7 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
         {"baseline", baseline_path.empty() ? nlohmann::json(nullptr) : nlohmann::json(file_fingerprint(baseline_path))},
         {"baseline_factor", baseline.is_null() ? nlohmann::json(nullptr) : nlohmann::json(baseline_factor)}};
     shard_block = {{"index", shard->index},   {"count", shard->count},   {"command", gate ? "gate" : "run"},
-                   {"options", run_options}, {"scenarios", list}};
+                   {"options", run_options}, {"scenarios", list}, {"build", build_identity()}};
     std::cout << "shard " << shard->index << "/" << shard->count << ": " << mine.size() << " of " << scenes->size()
               << " scenarios (" << (total_cost > 0.0 ? static_cast<int>(100.0 * my_cost / total_cost + 0.5) : 0)
               << "% of the estimated cost)\n";
@@ -298,6 +299,10 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
   result.shard = shard_block;
   if (!baseline_path.empty()) {
     const int matched = apply_baseline(result, baseline, baseline_factor);
+    if (const int missing = add_runs_missing_from_baseline(result, baseline, o.engines); missing > 0) {
+      std::cout << "baseline: " << missing << " run(s) of the baseline not run now (an engine not loaded, or left out "
+                << "by a scenario's engines list): failed\n";
+    }
     std::cout << "baseline: " << matched << " runs matched in " << baseline_path << " (regression factor "
               << baseline_factor << ")\n";
     if (matched == 0) return bad_input(baseline_path + ": the baseline matches no run (scenario and engine): nothing compared");
@@ -623,6 +628,7 @@ int main(int argc, char** argv) {
       if (so.shard_count > 1) {
         // What the points depend on, for `physval merge` to compare the shards with.
         result.shard["command"] = "sweep";
+        result.shard["build"] = build_identity();
         result.shard["scenario"] = {{"name", load.scene->name}, {"file", file_fingerprint(sweep_scenario)}};
         result.shard["options"] = {{"dt", so.dts},
                                    {"engines", so.engines},
@@ -650,6 +656,12 @@ int main(int argc, char** argv) {
       }
       std::cout << "sweep: " << (std::filesystem::path(sweep_out) / "sweep.csv").string() << ", sweep.json, "
                 << "speed_vs_error.png, error_vs_dt.png in " << sweep_out << '\n';
+      if (so.shard_count <= 1) {   // a shard's points may all fail; merge decides for the whole sweep
+        if (const std::string nothing = sweep_measured_nothing(result); !nothing.empty()) {
+          std::cerr << "physval: sweep measured nothing: " << nothing << '\n';
+          return kExitFailed;
+        }
+      }
       return 0;
     }
   } catch (const std::exception& e) {

@@ -138,6 +138,50 @@ void BM_ContainmentObserveGas(benchmark::State& state) {
 }
 BENCHMARK(BM_ContainmentObserveGas)->Arg(200)->Arg(1000)->Unit(benchmark::kMicrosecond);
 
+// Containment after one step of orbit_1000_periods (two points, no barriers: 2M calls in
+// the built-in suite, a fixed cost of every step of every small scene).
+void BM_ContainmentObserveTwoPoints(benchmark::State& state) {
+  Scene scene;
+  scene.name = "orbit";
+  scene.world.newtonian = true;
+  for (int k = 0; k < 2; ++k) {
+    BodyDef b;
+    b.name = k == 0 ? "sun_a" : "sun_b";
+    b.shape = ShapeKind::Point;
+    b.radius = 0.0;
+    b.position = {k == 0 ? 1.0 : -1.0, 0.0};
+    b.velocity = {0.0, k == 0 ? 0.5 : -0.5};
+    scene.bodies.push_back(b);
+  }
+  std::vector<BodyState> states(2);
+  for (std::size_t i = 0; i < 2; ++i) {
+    states[i].position = scene.bodies[i].position;
+    states[i].velocity = scene.bodies[i].velocity;
+  }
+  ContainmentMonitor monitor(scene);
+  monitor.start(states);
+  // One period's 400 steps of the circular orbit, computed beforehand and cycled (the
+  // time goes on), so that only observe is timed.
+  const double h = 0.031415926535897934;
+  std::vector<std::vector<BodyState>> orbit(400, states);
+  for (std::size_t k = 0; k < orbit.size(); ++k) {
+    for (std::size_t i = 0; i < 2; ++i) {
+      const double a = 0.5 * h * static_cast<double>(k + 1) + (i == 0 ? 0.0 : 3.141592653589793);
+      orbit[k][i].position = {std::cos(a), std::sin(a)};
+      orbit[k][i].velocity = {-0.5 * std::sin(a), 0.5 * std::cos(a)};
+    }
+  }
+  double t = 0.0;
+  std::size_t k = 0;
+  for (auto _ : state) {
+    t += h;
+    monitor.observe(t, orbit[k]);
+    k = k + 1 == orbit.size() ? 0 : k + 1;
+    benchmark::DoNotOptimize(monitor.record());
+  }
+}
+BENCHMARK(BM_ContainmentObserveTwoPoints)->Unit(benchmark::kNanosecond);
+
 
 // The series CSVs' number text (results_json.cpp writes six CSVs of up to 807 columns a
 // sample; on circle_gas that was a third of the harness): 4096 positions of a gas (full

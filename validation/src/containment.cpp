@@ -80,6 +80,7 @@ ContainmentMonitor::ContainmentMonitor(const Scene& scene) : scene_(scene) {
   }
   eps_ = 1e-9 * extent;
   for (const BodyDef& d : scene.bodies) radius_.push_back(d.shape == ShapeKind::Point ? 0.0 : d.radius);
+  pairs_possible_ = std::any_of(moving_.begin(), moving_.end(), [&](std::size_t i) { return radius_[i] != 0.0; });
   max_radius_ = max_radius;
   for (const Barrier& b : barriers_) {
     const double r = b.circle ? b.radius : 0.0;
@@ -250,7 +251,10 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
   // The sort compares the left ends laid out in the order's order (sorted_lo_, gathered
   // first), moving them with the order: the same comparisons on the same values as
   // reading lo_ through the order, without the indirection.
-  const std::size_t n = order_.size();
+  // Only points move (orbits, projectiles): no pair of them can overlap or count as passed
+  // into each other (the pair test below leaves every such pair at once), so the sweep is
+  // skipped as a whole; the barriers are still checked for every body.
+  const std::size_t n = pairs_possible_ ? order_.size() : 0;
   sorted_lo_.resize(n);
   for (std::size_t p = 0; p < n; ++p) sorted_lo_[p] = lo_[order_[p]];
   for (std::size_t p = 1; p < n; ++p) {
@@ -381,6 +385,9 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
       const double reach_j = (ri + rj) * (1.0 + 1e-9);
       if (sorted_y_[q].lo > yhi + reach_j || sorted_y_[q].hi < ylo - reach_j) continue;
       if (!pair_collides_[gi + body_group_[j]]) continue;
+      // Two points: no overlap can be deeper than 0 (max_penetration starts there), and they
+      // are never counted as passed into each other (that wants a radius, see below).
+      if (ri == 0.0 && rj == 0.0) continue;
       const Vec2 xj = pos_[j];
       const double depth = ri + rj - length(xi - xj);
       if (depth > record_.max_penetration) {
@@ -394,6 +401,9 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
       // when both steps were straight (neither body met anything in it), each bend added.
       // A point (radius 0) has passed into a circle when it gets half-way to its centre.
       const double smaller = std::min(ri, rj) > 0.0 ? std::min(ri, rj) : 0.5 * std::max(ri, rj);
+      // Two points (no radius either, or a radius that is not a number) are never counted as
+      // passed into each other (the test at the end wants smaller > 0): nothing below for them.
+      if (!(smaller > 0.0)) continue;
       // Of two circles of unequal size, the small one has gone into the large one when it
       // is wholly inside it (centres closer than the difference of the radii: an overlap
       // deeper than the small one's diameter): a 1 cm ball at 10-300 m/s went 0.5 m deep
@@ -448,7 +458,21 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
     }
   }
 
-  // Each moving body against the barriers near its path since the last step.
+  // Each moving body against the barriers near its path since the last step (with none,
+  // only the step's end is remembered, as at the end of the loop below).
+  if (barriers_.empty()) {
+    for (const std::size_t i : moving_) {
+      if (!alive_[i]) {
+        previous_alive_[i] = 0;
+        continue;
+      }
+      previous_[i] = pos_[i];
+      previous_velocity_[i] = states[i].velocity;
+      previous_alive_[i] = 1;
+    }
+    previous_time_ = t;
+    return;
+  }
   for (std::size_t i : moving_) {
     if (!alive_[i]) {
       previous_alive_[i] = 0;

@@ -85,6 +85,7 @@ class ContainmentMonitor {
   std::vector<std::uint32_t> strip_of_, strip_start_, strip_cursor_, strip_item_;
   std::vector<double> strip_lo_;
   double max_radius_ = 0.0;                    // of the moving bodies
+  bool pairs_possible_ = true;                 // false: every moving body is a point (radius 0)
   std::vector<std::uint32_t> on_line_count_;   // on_line_ entries of the body
   // Each barrier's bounding box, widened by 2 eps: a body's path whose box misses it
   // can neither touch nor cross it (see observe).

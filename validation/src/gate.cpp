@@ -1,6 +1,8 @@
 #include "physval/validation/gate.hpp"
 
 #include "markup_escape.hpp"
+#include "physval/adapters/registry.hpp"
+#include "physval/validation/runner.hpp"
 
 #include <unistd.h>
 
@@ -18,6 +20,8 @@ namespace physval {
 namespace {
 
 std::string xml_escape(const std::string& s) { return markup_escape(s); }
+
+std::string json_text_default() { return std::string(); }
 
 std::string g(double v) {
   std::ostringstream os;
@@ -63,6 +67,15 @@ std::vector<std::string> failed_checks(const RunRecord& r) {
 }
 
 }  // namespace
+
+void discard_earlier_junit(const std::string& file) {
+  if (file.empty()) return;
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(std::filesystem::symlink_status(file, ec)) ||
+      std::filesystem::is_symlink(std::filesystem::symlink_status(file, ec))) {
+    std::filesystem::remove(file, ec);
+  }
+}
 
 std::string junit_xml(const SuiteResult& result) {
   int tests = 0, failures = 0, errors = 0, skipped = 0;
@@ -185,6 +198,43 @@ int apply_baseline(SuiteResult& result, const nlohmann::json& baseline, double f
     }
   }
   return matched;
+}
+
+int add_runs_missing_from_baseline(SuiteResult& result, const nlohmann::json& baseline,
+                                   const std::vector<std::string>& wanted) {
+  if (!baseline.contains("runs") || !baseline["runs"].is_array()) return 0;
+  int added = 0;
+  for (ScenarioResult& sr : result.scenarios) {
+    for (const nlohmann::json& old : baseline["runs"]) {
+      if (!old.is_object() || old.value("scenario", json_text_default()) != sr.scene.name) continue;
+      const std::string engine = old.value("engine", json_text_default());
+      const std::string before = old.contains("status") && old["status"].is_string() ? old["status"].get<std::string>()
+                                                                                    : std::string("unsupported");
+      if (engine.empty() || before == "unsupported") continue;
+      if (!wanted.empty() && std::find(wanted.begin(), wanted.end(), engine) == wanted.end()) continue;   // left out
+      const bool ran = std::any_of(sr.runs.begin(), sr.runs.end(), [&](const RunRecord& r) { return r.engine == engine; });
+      if (ran) continue;
+      EngineInfo info;
+      info.name = engine;
+      info.version = old.value("engine_version", json_text_default());
+      info.precision = old.value("precision", json_text_default()) == "float32" ? Precision::Float32 : Precision::Float64;
+      RunRecord r = unsupported_run(sr.scene, info, {});
+      r.reason = find_engine(engine) == nullptr
+                     ? "not run: no engine named " + engine + " is loaded in this physval (a plugin not found or not given)"
+                     : "not run: the scenario's own engines list leaves " + engine + " out";
+      Check c;
+      c.what = "baseline.status";
+      c.limit = 0.0;
+      c.value.reset();
+      c.pass = false;
+      c.enforced = true;
+      c.detail = "the baseline ran it (status " + before + "); this run did not (" + r.reason + ")";
+      r.checks.push_back(std::move(c));
+      sr.runs.push_back(std::move(r));
+      ++added;
+    }
+  }
+  return added;
 }
 
 }  // namespace physval

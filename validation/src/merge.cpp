@@ -37,6 +37,21 @@ json read_json(const fs::path& file) {
   }
 }
 
+// What differs between two shards' build blocks, in words.
+std::string build_difference(const json& a, const json& b) {
+  if (!a.is_object() || !b.is_object()) return "one was written by a physval that does not record its build";
+  if (a.value("executable", "") != b.value("executable", "")) return "another physval executable";
+  if (a.value("engines", json()) != b.value("engines", json())) {
+    auto list = [](const json& engines) {
+      std::string text;
+      for (const json& e : engines) text += (text.empty() ? "" : ", ") + e.value("name", "?") + " " + e.value("version", "?");
+      return text;
+    };
+    return "engines " + list(a.value("engines", json::array())) + " against " + list(b.value("engines", json::array()));
+  }
+  return "another plugin library";
+}
+
 struct Part {
   std::string dir;
   json doc;
@@ -80,11 +95,15 @@ std::vector<Part> read_parts(const std::vector<std::string>& dirs, const std::st
     }
     if (other != same) {
       std::string what = "options";
-      for (const char* key : {"command", "options", "scenarios", "scenario", "points"}) {
+      // The build first: another engine set also changes the split's costs.
+      for (const char* key : {"build", "command", "options", "scenarios", "scenario", "points"}) {
         if (other.value(key, json()) != same.value(key, json())) {
-          what = std::string(key) == "scenarios" || std::string(key) == "scenario"
-                     ? "scenario set (names or file contents)"
-                     : std::string(key) == "command" ? "command (run against gate)" : std::string(key);
+          const std::string k = key;
+          what = k == "scenarios" || k == "scenario" ? "scenario set (names or file contents)"
+                 : k == "command"                    ? "command (run against gate)"
+                 : k == "build" ? "build (physval executable, engines and their versions, or plugin libraries: " +
+                                      build_difference(other.value(key, json()), same.value(key, json())) + ")"
+                                : k;
           break;
         }
       }
@@ -145,6 +164,12 @@ int merge_suite(const MergeOptions& options, std::ostream& out, std::ostream& er
     for (const auto& [scenario, i] : owner) {
       if (i == index && !references.count(scenario)) {
         throw Refused(p.dir + ": scenario " + scenario + " of shard " + std::to_string(index) + " is missing from it");
+      }
+      // Every scenario's series folder holds its scene.json: without it the folder was
+      // copied in part (an artifact upload cut short), and the merge would lack its series.
+      if (i == index && !fs::exists(fs::path(p.dir) / "series" / scenario / "scene.json")) {
+        throw Refused(p.dir + ": the series of scenario " + scenario + " are missing (series/" + scenario +
+                      "/scene.json): the folder is not a whole shard output");
       }
     }
   }
@@ -235,6 +260,10 @@ int merge_sweep(const MergeOptions& options, std::ostream& out, std::ostream& er
   }
   out << "sweep: " << (fs::path(out_dir) / "sweep.csv").string() << ", sweep.json, speed_vs_error.png, error_vs_dt.png in "
       << out_dir << '\n';
+  if (const std::string nothing = sweep_measured_nothing(result); !nothing.empty()) {
+    err << "physval: sweep measured nothing: " << nothing << '\n';
+    return 1;
+  }
   return 0;
 }
 
@@ -279,6 +308,7 @@ SuiteResult suite_from_json(const json& results) {
 }
 
 int merge_shards(const MergeOptions& options, std::ostream& out, std::ostream& err) {
+  discard_earlier_junit(options.junit);   // a refused merge leaves no JUnit file, not the last one
   try {
     if (options.dirs.empty()) throw Refused("merge: no folders given");
     bool suite = false, sweep = false;

@@ -8,8 +8,11 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <map>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string_view>
 #include <thread>
 
 #include "physval/adapters/registry.hpp"
@@ -41,40 +44,6 @@ std::string hash_hex(const std::string& text) {
   return buf;
 }
 
-// Eight bytes at a time (two multiply-xorshift lanes): the executable is megabytes, and
-// byte-wise FNV under the sanitizers' instrumentation took ~25 s per physval process.
-#if defined(__clang__) || defined(__GNUC__)
-__attribute__((no_sanitize("address", "undefined")))
-#endif
-std::string hash_file_bytes(const std::string& bytes) {
-  std::uint64_t h1 = 14695981039346656037ull ^ bytes.size(), h2 = 0x9e3779b97f4a7c15ull;
-  const std::size_t words = bytes.size() / 8;
-  for (std::size_t i = 0; i < words; ++i) {
-    std::uint64_t w;
-    std::memcpy(&w, bytes.data() + 8 * i, 8);
-    h1 = (h1 ^ w) * 0xff51afd7ed558ccdull;
-    h1 ^= h1 >> 32;
-    h2 = (h2 ^ w) * 0xc4ceb9fe1a85ec53ull + 0x632be59bd9b4e019ull;
-    h2 ^= h2 >> 29;
-  }
-  return hash_hex(bytes.substr(8 * words) + std::to_string(h1) + ":" + std::to_string(h2));
-}
-
-// The running executable's bytes, hashed once: any rebuild of physval with other code
-// is another key, even at the same version number.
-const std::string& executable_hash() {
-  static const std::string hash = [] {
-    std::ifstream in("/proc/self/exe", std::ios::binary | std::ios::ate);
-    if (!in) return std::string("unknown-executable");
-    const std::streamsize size = in.tellg();
-    std::string bytes(static_cast<std::size_t>(std::max<std::streamsize>(size, 0)), '\0');
-    in.seekg(0);
-    if (size <= 0 || !in.read(bytes.data(), size)) return std::string("unknown-executable");
-    return hash_file_bytes(bytes);
-  }();
-  return hash;
-}
-
 std::string exact(double v) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%a", v);
@@ -94,9 +63,23 @@ json reference_to_json(const std::string& key, const Reference& ref) {
   return j;
 }
 
-std::optional<Reference> reference_from(const std::string& bytes, const std::string& key) {
+// An entry's bytes: the CBOR document, then a newline and the hash of the document's
+// bytes (32 hex digits). A flipped byte anywhere (a damaged disk, a file edited or
+// overwritten in part) fails the hash, and the entry is recomputed: without it, a byte
+// changed inside the run's series still decoded, and the run was compared with another
+// reference than the one computed.
+constexpr std::size_t kSealSize = 1 + 32;
+
+std::string seal_of(const std::vector<std::uint8_t>& cbor) {
+  return '\n' + hash_file_bytes(std::string_view(reinterpret_cast<const char*>(cbor.data()), cbor.size()));
+}
+
+std::optional<Reference> reference_from(const std::string& entry, const std::string& key) {
+  if (entry.size() <= kSealSize || entry[entry.size() - kSealSize] != '\n') return std::nullopt;
+  const std::string_view bytes(entry.data(), entry.size() - kSealSize);
+  if (hash_file_bytes(bytes) != std::string_view(entry).substr(entry.size() - kSealSize + 1)) return std::nullopt;
   try {
-    const json j = json::from_cbor(bytes);
+    const json j = json::from_cbor(bytes.begin(), bytes.end());
     if (j.at("key").get<std::string>() != key) return std::nullopt;
     Reference ref;
     ref.available = j.at("available").get<bool>();
@@ -122,10 +105,12 @@ void store(const std::filesystem::path& dir, const std::string& name, const std:
            << counter.fetch_add(1) << '-' << name;
   const std::filesystem::path tmp = dir / tmp_name.str();
   const std::vector<std::uint8_t> bytes = json::to_cbor(reference_to_json(key, ref));
+  const std::string seal = seal_of(bytes);
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) return;
     out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    out.write(seal.data(), static_cast<std::streamsize>(seal.size()));
     out.flush();
     if (!out) {
       out.close();
@@ -139,6 +124,51 @@ void store(const std::filesystem::path& dir, const std::string& name, const std:
 
 }  // namespace
 
+// Eight bytes at a time (two multiply-xorshift lanes): the executable is megabytes, and
+// byte-wise FNV under the sanitizers' instrumentation took ~25 s per physval process.
+#if defined(__clang__) || defined(__GNUC__)
+__attribute__((no_sanitize("address", "undefined")))
+#endif
+std::string hash_file_bytes(std::string_view bytes) {
+  std::uint64_t h1 = 14695981039346656037ull ^ bytes.size(), h2 = 0x9e3779b97f4a7c15ull;
+  const std::size_t words = bytes.size() / 8;
+  for (std::size_t i = 0; i < words; ++i) {
+    std::uint64_t w;
+    std::memcpy(&w, bytes.data() + 8 * i, 8);
+    h1 = (h1 ^ w) * 0xff51afd7ed558ccdull;
+    h1 ^= h1 >> 32;
+    h2 = (h2 ^ w) * 0xc4ceb9fe1a85ec53ull + 0x632be59bd9b4e019ull;
+    h2 ^= h2 >> 29;
+  }
+  return hash_hex(std::string(bytes.substr(8 * words)) + std::to_string(h1) + ":" + std::to_string(h2));
+}
+
+// The running executable's bytes, hashed once: any rebuild of physval with other code
+// is another key, even at the same version number.
+const std::string& executable_hash() {
+  static const std::string hash = [] {
+    std::ifstream in("/proc/self/exe", std::ios::binary | std::ios::ate);
+    if (!in) return std::string("unknown-executable");
+    const std::streamsize size = in.tellg();
+    std::string bytes(static_cast<std::size_t>(std::max<std::streamsize>(size, 0)), '\0');
+    in.seekg(0);
+    if (size <= 0 || !in.read(bytes.data(), size)) return std::string("unknown-executable");
+    return hash_file_bytes(bytes);
+  }();
+  return hash;
+}
+
+namespace {
+std::mutex g_loaded_mutex;
+std::map<std::string, std::string> g_loaded_text_hash;   // scenario file -> hash of the text parsed
+}  // namespace
+
+void note_loaded_scenario_text(const std::string& file, const std::string& text) {
+  const std::string hash = hash_file_bytes(text);
+  const std::lock_guard<std::mutex> lock(g_loaded_mutex);
+  g_loaded_text_hash[file] = hash;
+}
+
 std::filesystem::path default_reference_cache_dir() {
   if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg == '/') {
     return std::filesystem::path(xdg) / "physval" / "references";
@@ -151,6 +181,11 @@ std::string reference_cache_key(const Scene& scene, const RunOptions& options) {
   if (scene.source_file.empty()) return {};
   const std::string text = read_bytes(scene.source_file);
   if (text.empty()) return {};
+  {
+    const std::lock_guard<std::mutex> lock(g_loaded_mutex);
+    auto it = g_loaded_text_hash.find(scene.source_file);
+    if (it != g_loaded_text_hash.end() && it->second != hash_file_bytes(text)) return {};   // edited since loaded
+  }
   std::ostringstream key;
   key << "physval " << PHYSVAL_VERSION << " executable " << executable_hash() << '\n';
   if (const EngineFactory* engine = reference_engine()) {

@@ -443,4 +443,20 @@ RunRecord read_run_record(int fd, std::optional<std::chrono::steady_clock::time_
   }
 }
 
+RunRecord read_run_record(int fd, std::optional<std::chrono::steady_clock::time_point> deadline, std::size_t& bytes_read,
+                          double& after) {
+  FdSource source{fd, deadline};
+  try {
+    RunRecord r = read_record(source);
+    source.get(&after, sizeof after);
+    bytes_read = source.total;
+    // Nothing may follow: the writer sends its next record only when asked.
+    if (source.begin != source.end) throw std::runtime_error("run record: trailing bytes");
+    return r;
+  } catch (...) {
+    bytes_read = source.total;
+    throw;
+  }
+}
+
 }  // namespace physval

@@ -7,6 +7,7 @@
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/resource.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -21,6 +22,8 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <limits>
+#include <thread>
 #include <numbers>
 #include <sstream>
 
@@ -112,9 +115,43 @@ std::string object_name(const Scene& scene, const std::vector<BodyMeta>& metas, 
   return "?";
 }
 
-void refresh_metas(const Engine& engine, std::vector<BodyMeta>& metas) {
+void refresh_metas(const Engine& engine, std::vector<BodyMeta>& metas, const Scene& scene) {
   const std::size_t n = engine.body_count();
+  // Objects beyond the scene's bodies are particles, which only emitters make. Others (a
+  // helper body an engine made for itself, a body doubled) would be counted in the
+  // energy and momenta: one that took up the energy the scene's bodies lost hid it.
+  if (n > scene.bodies.size() && scene.emitters.empty()) {
+    throw std::runtime_error(engine.info().name + " reports " + std::to_string(n) + " bodies, but the scene has " +
+                             std::to_string(scene.bodies.size()) + " and no emitter to make more");
+  }
   for (std::size_t i = metas.size(); i < n; ++i) metas.push_back(engine.body_meta(i));
+}
+
+// The scene's bodies as the engine reports them must be the scene's: the energy, the
+// momenta and containment are computed from the reported mass, radius and static flag.
+// An engine (a plugin) that reported its bodies massless or static had an energy and a
+// momentum of 0 at every sample, so every drift limit passed whatever it did. Masses
+// and radii are held to float32's round-off (Box2D derives mass from a density).
+void check_scene_bodies(const Scene& scene, const std::vector<BodyMeta>& metas, const std::string& engine) {
+  auto close = [](double a, double b) { return std::abs(a - b) <= 1e-5 * std::max(std::abs(a), std::abs(b)) + 1e-12; };
+  for (std::size_t i = 0; i < scene.bodies.size() && i < metas.size(); ++i) {
+    const BodyDef& want = scene.bodies[i];
+    const BodyMeta& got = metas[i];
+    std::string wrong;
+    if (got.name != want.name) {
+      wrong = "is named \"" + got.name + "\"";
+    } else if (got.is_static != want.is_static) {
+      wrong = got.is_static ? "is static" : "is not static";
+    } else if (!want.is_static && !close(got.mass, want.mass)) {
+      wrong = "has a mass of " + std::to_string(got.mass) + " kg (the scene's: " + std::to_string(want.mass) + " kg)";
+    } else if (!close(got.radius, want.radius)) {
+      wrong = "has a radius of " + std::to_string(got.radius) + " m (the scene's: " + std::to_string(want.radius) + " m)";
+    }
+    if (!wrong.empty()) {
+      throw std::runtime_error(engine + " reports the scene's body " + std::to_string(i) + " (\"" + want.name + "\") as one that " +
+                               wrong + ": its energy and momenta would not be the scene's");
+    }
+  }
 }
 
 bool states_finite(const std::vector<BodyState>& states) {
@@ -166,7 +203,8 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     engine->load(scene);
     r.load_seconds = std::chrono::duration<double>(clock::now() - t_load).count();
     r.settings = engine->settings();
-    refresh_metas(*engine, r.bodies);
+    refresh_metas(*engine, r.bodies, scene);
+    check_scene_bodies(scene, r.bodies, factory.info.name);
 
     // Probes: every step, for the bodies the expectations name.
     std::vector<ProbeTracker> trackers;
@@ -186,12 +224,36 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     for (const ExpectedPeriod& p : scene.expect.period) add_probe(p.body, true, p.around);
 
     const long every = sample_every(scene, options.max_sample_states);
+    // Which of the scene's bodies anything in the scene can destroy: a collision-matrix
+    // destroy rule (any body may meet one), or an explode emitter (its parent). Positions
+    // of a body dead in either run are not compared, so an engine that reported bodies
+    // destroyed that nothing destroys was compared on nothing but its energy: with
+    // friction in the scene (no energy conserved) a position gate passed it.
+    const bool destroy_rules = std::any_of(scene.collision_matrix.begin(), scene.collision_matrix.end(), [](const CollisionRule& c) {
+      return c.response == CollisionResponse::DestroyA || c.response == CollisionResponse::DestroyB ||
+             c.response == CollisionResponse::DestroyBoth;
+    });
+    std::vector<bool> may_die(scene.bodies.size(), destroy_rules);
+    for (const EmitterDef& e : scene.emitters) {
+      if (e.mode != EmitterMode::Explode) continue;
+      if (const int i = scene.body_index(e.parent); i >= 0) may_die[static_cast<std::size_t>(i)] = true;
+    }
+    auto check_deaths = [&] {
+      for (std::size_t i = 0; i < may_die.size() && i < states.size(); ++i) {
+        if (!states[i].alive && !may_die[i]) {
+          throw std::runtime_error(factory.info.name + " reports the scene's body " + std::to_string(i) + " (\"" +
+                                   scene.bodies[i].name + "\") destroyed, but nothing in the scene destroys it (no " +
+                                   "collision-matrix destroy rule, no explode emitter of it)");
+        }
+      }
+    };
     // A sample is finite when every live body's state is and so are the totals made of
     // them: a body at 1e160 m/s has a finite state and an infinite kinetic energy, whose
     // drift (inf - inf) was skipped as NaN and read 0, a vacuous pass of any gate.
     auto sample = [&](double t) {
       engine->read_states(states);
-      refresh_metas(*engine, r.bodies);
+      check_deaths();
+      refresh_metas(*engine, r.bodies, scene);
       r.series.time.push_back(t);
       const Totals totals = compute_totals(scene, r.bodies, states);
       r.series.totals.push_back(totals);
@@ -248,6 +310,8 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     const auto loop_t0 = clock::now();
     const StepTicks loop_ticks0 = step_ticks();
     StepTicks step_ticks_total = 0;
+    long until_sample = every;   // steps to the next sample: k % every == 0 without a division a step
+    double stepped = 0.0;   // the time the steps asked for add up to
     for (long k = 1; k <= n && r.status == RunStatus::Ok; ++k) {
       const double h = k == n ? last_dt : scene.dt;
       const StepTicks t0 = step_ticks();
@@ -256,13 +320,23 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
       r.steps = k;
       const std::vector<ContactEvent>& events = engine->contacts();
       if (!events.empty()) {
-        refresh_metas(*engine, r.bodies);
+        refresh_metas(*engine, r.bodies, scene);
         for (const ContactEvent& e : events) {
           r.contacts.push_back({object_name(scene, r.bodies, e.a), object_name(scene, r.bodies, e.b), e.time, k});
         }
       }
       const double t = engine->time();
-      const bool sampled = (k % every == 0) || k == n;
+      // Samples are paired with the reference's by this clock (to 1% of a step): one that
+      // is not the steps taken paired no sample, or the wrong ones, and a run whose clock
+      // ran 0.1% fast measured a position divergence of 0.
+      stepped += h;
+      if (!(std::abs(t - stepped) <= 0.01 * scene.dt)) {
+        throw std::runtime_error(factory.info.name + " reports its time as " + std::to_string(t) + " s after step " +
+                                 std::to_string(k) + ", but it was stepped " + std::to_string(stepped) + " s");
+      }
+      const bool on_interval = --until_sample == 0;
+      if (on_interval) until_sample = every;
+      const bool sampled = on_interval || k == n;
       if (std::string broken = engine->broken_guarantee(); !broken.empty()) {
         sample(t);
         r.status = RunStatus::Diverged;
@@ -273,7 +347,9 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
         r.reason = "state became NaN or infinite (a position or velocity, or the energy or momentum made of them)";
         r.diverged_at = t;
       }
-      if (!sampled) engine->read_states(states);
+      // Containment and the probes read positions, velocities and liveness only (the
+      // angles in `states` may be a sample's until the next one).
+      if (!sampled) engine->read_motion(states);
       containment.observe(t, states);
       update_probes(t, h, true);
     }
@@ -289,7 +365,7 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     r.limits_hit = engine->limits_hit();
     engine->read_states(states);
     r.final_states = states;
-    refresh_metas(*engine, r.bodies);
+    refresh_metas(*engine, r.bodies, scene);
     r.containment = containment.record();
   } catch (const std::exception& e) {
     r.status = RunStatus::Error;
@@ -375,6 +451,64 @@ std::string seconds_text(double seconds) {
 
 namespace {
 
+// Reaps a child (after forgetting it: an unreaped pid cannot be reused by another
+// process); its whole CPU time, s.
+double reap(pid_t pid, int& wstatus) {
+  forget_live_child(pid);
+  wstatus = 0;
+  struct rusage usage{};
+  while (::wait4(pid, &wstatus, 0, &usage) < 0 && errno == EINTR) {
+  }
+  return static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
+// Why a child's end makes its run an error, or "" when it exited 0 after sending something.
+std::string exit_failure(int wstatus, std::size_t bytes_read) {
+  if (WIFSIGNALED(wstatus)) {
+    const int sig = WTERMSIG(wstatus);
+    return std::string("engine crashed: signal ") + std::to_string(sig) + " (" + strsignal(sig) + ")";
+  }
+  if (!WIFEXITED(wstatus) || WEXITSTATUS(wstatus) != 0 || bytes_read == 0) {
+    return "engine process exited with status " + std::to_string(WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1);
+  }
+  return {};
+}
+
+// The reason of a run whose child (reaped, `wstatus`) gave no whole record, or ran out of time.
+void judge_failed_child(RunRecord& fallback, bool timed_out, int wstatus, std::size_t bytes_read,
+                        const std::string& read_error, const RunOptions& options) {
+  if (timed_out) {
+    fallback.reason = "timed out after " + seconds_text(options.timeout_seconds) + " s";
+  } else if (std::string why = exit_failure(wstatus, bytes_read); !why.empty()) {
+    fallback.reason = std::move(why);
+  } else {
+    fallback.reason = "could not read the engine process's result: " + read_error;
+  }
+}
+
+// The deadline of an isolated run: its timeout from now, or the shared deadline if earlier.
+std::optional<std::chrono::steady_clock::time_point> run_deadline(const RunOptions& options) {
+  std::optional<std::chrono::steady_clock::time_point> deadline;
+  if (options.timeout_seconds > 0.0) {
+    deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                      std::chrono::duration<double>(options.timeout_seconds));
+  }
+  if (options.deadline) deadline = deadline ? std::min(*deadline, *options.deadline) : *options.deadline;
+  return deadline;
+}
+
+// Whatever else a child writes is drained, so it is never left blocked on a full pipe.
+void drain(int fd, std::size_t& bytes_read) {
+  std::uint8_t sink[1 << 12];
+  for (;;) {
+    const ssize_t got = ::read(fd, sink, sizeof sink);
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) break;
+    bytes_read += static_cast<std::size_t>(got);
+  }
+}
+
 // `owned`: the caller's scene, released in the parent as soon as the child has its copy
 // (a large scene's copy need not live while the record comes back).
 RunRecord run_isolated(const Scene& scene, const EngineFactory& factory, const RunOptions& options, Scene* owned) {
@@ -413,55 +547,29 @@ RunRecord run_isolated(const Scene& scene, const EngineFactory& factory, const R
   fallback.status = RunStatus::Error;
   if (owned != nullptr) *owned = Scene{};   // `scene` is not read again below
   // The record is read straight from the pipe into a RunRecord as it arrives.
-  std::optional<std::chrono::steady_clock::time_point> deadline;
-  if (options.timeout_seconds > 0.0) {
-    deadline = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                      std::chrono::duration<double>(options.timeout_seconds));
-  }
-  if (options.deadline) deadline = deadline ? std::min(*deadline, *options.deadline) : *options.deadline;
+  const std::optional<std::chrono::steady_clock::time_point> deadline = run_deadline(options);
   bool timed_out = false;
   std::optional<RunRecord> record;
   std::string read_error;
   std::size_t bytes_read = 0;
+  int wstatus_of_reaped = 0;
   try {
     record = read_run_record(fds[0], deadline, bytes_read);
   } catch (const RecordTimeout&) {
     timed_out = true;
   } catch (const std::exception& e) {
     read_error = e.what();
-    // Whatever else the child writes is drained, so it is never left blocked on a full pipe.
-    std::uint8_t sink[1 << 12];
-    for (;;) {
-      const ssize_t got = ::read(fds[0], sink, sizeof sink);
-      if (got < 0 && errno == EINTR) continue;
-      if (got <= 0) break;
-      bytes_read += static_cast<std::size_t>(got);
-    }
+    drain(fds[0], bytes_read);
   }
   ::close(fds[0]);
   if (timed_out) ::kill(pid, SIGKILL);
-  forget_live_child(pid);   // before reaping: an unreaped pid cannot be reused by another process
-  int wstatus = 0;
-  struct rusage usage{};
-  while (::wait4(pid, &wstatus, 0, &usage) < 0 && errno == EINTR) {
-  }
-  fallback.child_cpu_seconds = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
-                               1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-  if (timed_out) {
-    fallback.reason = "timed out after " + seconds_text(options.timeout_seconds) + " s";
+  fallback.child_cpu_seconds = reap(pid, wstatus_of_reaped);
+  if (!record || timed_out) {
+    judge_failed_child(fallback, timed_out, wstatus_of_reaped, bytes_read, read_error, options);
     return fallback;
   }
-  if (WIFSIGNALED(wstatus)) {
-    const int sig = WTERMSIG(wstatus);
-    fallback.reason = std::string("engine crashed: signal ") + std::to_string(sig) + " (" + strsignal(sig) + ")";
-    return fallback;
-  }
-  if (!WIFEXITED(wstatus) || WEXITSTATUS(wstatus) != 0 || bytes_read == 0) {
-    fallback.reason = "engine process exited with status " + std::to_string(WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1);
-    return fallback;
-  }
-  if (!record) {
-    fallback.reason = "could not read the engine process's result: " + read_error;
+  if (std::string why = exit_failure(wstatus_of_reaped, bytes_read); !why.empty()) {
+    fallback.reason = std::move(why);
     return fallback;
   }
   record->child_cpu_seconds = fallback.child_cpu_seconds;
@@ -482,6 +590,215 @@ RunRecord run_engine_isolated(const Scene& scene, const EngineFactory& factory, 
 
 RunRecord run_engine_isolated(Scene&& scene, const EngineFactory& factory, const RunOptions& options) {
   return run_isolated(scene, factory, options, &scene);
+}
+
+// --- Run workers -------------------------------------------------------------------
+
+namespace {
+
+// What the parent asks of a worker: a run of one of its scenes on one registered engine.
+struct WorkerRequest {
+  std::uint64_t scene;
+  std::uint64_t engine;
+  std::uint64_t max_sample_states;
+};
+
+double process_cpu_seconds() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// False at end of stream (or any error) before n bytes came.
+bool read_exactly(int fd, void* p, std::size_t n) {
+  auto* c = static_cast<std::uint8_t*>(p);
+  while (n > 0) {
+    const ssize_t got = ::read(fd, c, n);
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) return false;
+    c += got;
+    n -= static_cast<std::size_t>(got);
+  }
+  return true;
+}
+
+bool write_exactly(int fd, const void* p, std::size_t n) {
+  const auto* c = static_cast<const std::uint8_t*>(p);
+  while (n > 0) {
+    const ssize_t put = ::write(fd, c, n);
+    if (put < 0 && errno == EINTR) continue;
+    if (put <= 0) return false;
+    c += put;
+    n -= static_cast<std::size_t>(put);
+  }
+  return true;
+}
+
+// Closes every descriptor above stderr but the two given: a worker lives long, so it must
+// not hold another worker's pipe ends open (that worker's parent would never see its end).
+void close_all_but(int a, int b) {
+  if (a > b) std::swap(a, b);
+  auto close_from_to = [](int lo, int hi) {
+    if (lo <= hi) (void)::close_range(static_cast<unsigned>(lo), static_cast<unsigned>(hi), 0);
+  };
+  close_from_to(3, a - 1);
+  close_from_to(a + 1, b - 1);
+  close_from_to(b + 1, std::numeric_limits<int>::max());
+}
+
+// The worker's life: a request, the run, its record and then the CPU it cost (from the end
+// of the previous run, or the fork), until the parent closes its end. Exit statuses as an
+// isolated run's child: 3 the record could not be written, 4 an exception.
+[[noreturn]] void worker_main(int requests, int records, const std::vector<const Scene*>& scenes,
+                              const std::vector<const EngineFactory*>& engines) {
+  double mark = 0.0;   // a child's CPU clock starts at 0 at fork
+  for (;;) {
+    WorkerRequest q{};
+    if (!read_exactly(requests, &q, sizeof q)) ::_exit(0);
+    if (q.scene >= scenes.size() || q.engine >= engines.size()) ::_exit(6);
+    int code = 0;
+    try {
+      RunOptions o;
+      o.max_sample_states = static_cast<std::size_t>(q.max_sample_states);
+      const RunRecord r = run_engine(*scenes[q.scene], *engines[q.engine], o);
+      if (!write_run_record(records, r)) code = 3;
+    } catch (...) {
+      code = 4;
+    }
+    if (code != 0) ::_exit(code);
+    const double now = process_cpu_seconds();
+    const double cpu = now - mark;
+    mark = now;
+    if (!write_exactly(records, &cpu, sizeof cpu)) ::_exit(3);
+  }
+}
+
+}  // namespace
+
+struct RunWorkers::Worker {
+  std::thread::id thread;
+  pid_t pid = -1;
+  int requests = -1;   // socket (send with MSG_NOSIGNAL: a worker killed while idle is no SIGPIPE)
+  int records = -1;    // pipe, read end
+  double reported_cpu = 0.0;   // the CPU of the runs it finished, s
+
+  bool start(const std::vector<const Scene*>& scenes, const std::vector<const EngineFactory*>& engines) {
+    int sv[2];
+    if (::socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, sv) != 0) return false;
+    int fds[2];
+    if (::pipe2(fds, O_CLOEXEC) != 0) {
+      ::close(sv[0]);
+      ::close(sv[1]);
+      return false;
+    }
+    (void)::fcntl(fds[1], F_SETPIPE_SZ, 1 << 20);   // as for an isolated run
+    std::fflush(stdout);
+    std::fflush(stderr);
+    install_child_forwarding_handlers();
+    const pid_t parent = ::getpid();
+    const pid_t child = ::fork();
+    if (child < 0) {
+      for (int fd : {sv[0], sv[1], fds[0], fds[1]}) ::close(fd);
+      return false;
+    }
+    if (child == 0) {
+      // The forking thread outlives the worker (PR_SET_PDEATHSIG follows the thread).
+      die_with_parent(parent);
+      close_all_but(sv[1], fds[1]);
+      worker_main(sv[1], fds[1], scenes, engines);
+    }
+    remember_live_child(child);
+    ::close(sv[1]);
+    ::close(fds[1]);
+    pid = child;
+    requests = sv[0];
+    records = fds[0];
+    reported_cpu = 0.0;
+    return true;
+  }
+
+  // Closes the parent's ends (a live worker then exits 0) and reaps it; its CPU beyond
+  // the runs it reported, s.
+  double end(int& wstatus) {
+    if (requests >= 0) ::close(requests);
+    if (records >= 0) ::close(records);
+    requests = records = -1;
+    double unreported = 0.0;
+    if (pid > 0) unreported = reap(pid, wstatus) - reported_cpu;
+    pid = -1;
+    reported_cpu = 0.0;
+    return unreported;
+  }
+};
+
+RunWorkers::RunWorkers(std::vector<const Scene*> scenes, std::vector<const EngineFactory*> engines)
+    : scenes_(std::move(scenes)), engines_(std::move(engines)) {}
+
+RunWorkers::~RunWorkers() {
+  for (const std::unique_ptr<Worker>& w : workers_) {
+    int wstatus = 0;
+    w->end(wstatus);
+  }
+}
+
+RunWorkers::Worker& RunWorkers::mine() {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  const std::thread::id self = std::this_thread::get_id();
+  for (const std::unique_ptr<Worker>& w : workers_) {
+    if (w->thread == self) return *w;
+  }
+  workers_.push_back(std::make_unique<Worker>());
+  workers_.back()->thread = self;
+  return *workers_.back();
+}
+
+RunRecord RunWorkers::run(std::size_t scene_index, const EngineFactory& factory, const RunOptions& options) {
+  const Scene& scene = *scenes_.at(scene_index);
+  if (!options.isolate) return run_engine(scene, factory, options);
+  const auto known = std::find(engines_.begin(), engines_.end(), &factory);
+  if (known == engines_.end()) return run_engine_isolated(scene, factory, options);
+  const auto engine_index = static_cast<std::size_t>(known - engines_.begin());
+  Worker& w = mine();
+  const WorkerRequest q{scene_index, engine_index, options.max_sample_states};
+  bool sent = false;
+  for (int attempt = 0; attempt < 2 && !sent; ++attempt) {
+    if (w.pid < 0 && !w.start(scenes_, engines_)) break;
+    sent = ::send(w.requests, &q, sizeof q, MSG_NOSIGNAL) == static_cast<ssize_t>(sizeof q);
+    if (!sent) {   // it died while idle (killed from outside): a new one
+      int wstatus = 0;
+      w.end(wstatus);
+    }
+  }
+  if (!sent) return run_engine_isolated(scene, factory, options);   // no worker could be started
+
+  RunRecord fallback = blank_record(scene, factory.info);
+  fallback.status = RunStatus::Error;
+  bool timed_out = false;
+  std::optional<RunRecord> record;
+  std::string read_error;
+  std::size_t bytes_read = 0;
+  double cpu = 0.0;
+  try {
+    record = read_run_record(w.records, run_deadline(options), bytes_read, cpu);
+  } catch (const RecordTimeout&) {
+    timed_out = true;
+  } catch (const std::exception& e) {
+    read_error = e.what();
+    // No more requests: once it has written what it had, a live worker exits.
+    ::close(w.requests);
+    w.requests = -1;
+    drain(w.records, bytes_read);
+  }
+  if (record) {
+    record->child_cpu_seconds = cpu;
+    w.reported_cpu += cpu;
+    return std::move(*record);
+  }
+  if (timed_out) ::kill(w.pid, SIGKILL);
+  int wstatus = 0;
+  fallback.child_cpu_seconds = w.end(wstatus);
+  judge_failed_child(fallback, timed_out, wstatus, bytes_read, read_error, options);
+  return fallback;
 }
 
 }  // namespace physval

@@ -18,6 +18,7 @@
 #include "physval/adapters/registry.hpp"
 #include "physval/core/forces.hpp"
 #include "physval/validation/metric_names.hpp"
+#include "physval/validation/reference_cache.hpp"
 #include "physval/validation/runner.hpp"
 
 namespace physval {
@@ -1229,7 +1230,9 @@ ScenarioLoad load_scenario_file(const std::filesystem::path& file) {
   }
   std::ostringstream ss;
   ss << in.rdbuf();
-  return parse_scenario(ss.str(), file.string());
+  const std::string text = ss.str();
+  note_loaded_scenario_text(file.string(), text);   // the reference cache keys on this text
+  return parse_scenario(text, file.string());
 }
 
 SuiteLoad load_suite(const std::vector<std::string>& paths) {

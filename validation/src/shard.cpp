@@ -1,10 +1,18 @@
 #include "physval/validation/shard.hpp"
 
+#include <dlfcn.h>
+#include <link.h>
+
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <numeric>
+#include <set>
+
+#include "physval/adapters/registry.hpp"
+#include "physval/validation/reference_cache.hpp"
 
 namespace physval {
 
@@ -64,6 +72,38 @@ std::string file_fingerprint(const std::string& path) {
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
   return hex;
+}
+
+namespace {
+
+// The files of the loaded shared objects that export a physval plugin table.
+int collect_plugin_file(dl_phdr_info* info, std::size_t, void* data) {
+  if (info->dlpi_name == nullptr || info->dlpi_name[0] == '\0') return 0;
+  void* handle = ::dlopen(info->dlpi_name, RTLD_NOW | RTLD_NOLOAD);
+  if (handle == nullptr) return 0;
+  if (::dlsym(handle, "physval_plugin_v1") != nullptr) static_cast<std::set<std::string>*>(data)->insert(info->dlpi_name);
+  ::dlclose(handle);
+  return 0;
+}
+
+}  // namespace
+
+nlohmann::json build_identity() {
+  nlohmann::json engines = nlohmann::json::array();
+  for (const EngineFactory& f : engine_registry()) {
+    engines.push_back({{"name", f.info.name}, {"version", f.info.version}, {"precision", precision_name(f.info.precision)}});
+  }
+  std::set<std::string> files;
+  ::dl_iterate_phdr(collect_plugin_file, &files);
+  std::set<std::string> hashes;   // by content: the same library at another path is the same build
+  for (const std::string& file : files) {
+    std::ifstream in(file, std::ios::binary);
+    hashes.insert(in ? hash_file_bytes(std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()))
+                     : "unreadable");
+  }
+  return {{"executable", executable_hash()},
+          {"engines", engines},
+          {"plugin_libraries", nlohmann::json(std::vector<std::string>(hashes.begin(), hashes.end()))}};
 }
 
 }  // namespace physval

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <mutex>
+#include <optional>
 #include <sstream>
 
 #include "physval/validation/reference_cache.hpp"
@@ -72,6 +73,17 @@ SuiteResult run_suite(std::vector<Scene> scenes, const std::vector<std::string>&
     const std::string what = result.scenarios[t.scenario].scene.name + ": " + (t.engine ? t.engine->info.name : "reference");
     progress(what);   // the caller counts scenarios (physval's "[n/N]")
   };
+  // The engine runs go to long-lived workers (one per thread of run_tasks), forked when
+  // the scenes are final; the workers end (and are reaped) at the end of the runs.
+  std::vector<const Scene*> scene_list;
+  for (const ScenarioResult& sr : result.scenarios) scene_list.push_back(&sr.scene);
+  std::vector<const EngineFactory*> engine_list;
+  for (const std::vector<const EngineFactory*>& list : scenario_engines) {
+    for (const EngineFactory* f : list) {
+      if (std::find(engine_list.begin(), engine_list.end(), f) == engine_list.end()) engine_list.push_back(f);
+    }
+  }
+  std::optional<RunWorkers> workers(std::in_place, std::move(scene_list), std::move(engine_list));
   // References first, then the engine runs: one --timeout is the budget of an engine run
   // together with the reference it is compared with, so each engine run gets what its
   // scenario's reference left of it (README: "--timeout").
@@ -94,7 +106,7 @@ SuiteResult run_suite(std::vector<Scene> scenes, const std::vector<std::string>&
         return;
       }
       if (options.timeout_seconds <= 0.0) {
-        sr.runs[t.slot] = run_engine_isolated(sr.scene, *t.engine, options);
+        sr.runs[t.slot] = workers->run(t.scenario, *t.engine, options);
         sr.runs[t.slot].parent_cpu_seconds = thread_cpu_seconds() - cpu0;
         return;
       }
@@ -108,7 +120,7 @@ SuiteResult run_suite(std::vector<Scene> scenes, const std::vector<std::string>&
         r.reason = "timed out: the reference took " + seconds_text(spent) + " s of the --timeout budget of " +
                    seconds_text(options.timeout_seconds) + " s, nothing was left for this run";
       } else {
-        r = run_engine_isolated(sr.scene, *t.engine, budget);
+        r = workers->run(t.scenario, *t.engine, budget);
         if (r.status == RunStatus::Error && r.reason.rfind("timed out", 0) == 0 && spent > 0.0) {
           r.reason = "timed out: the engine run and the reference (" + seconds_text(spent) +
                      " s) together took longer than the --timeout budget of " +
@@ -119,6 +131,8 @@ SuiteResult run_suite(std::vector<Scene> scenes, const std::vector<std::string>&
       sr.runs[t.slot] = std::move(r);
     });
   }
+
+  workers.reset();
 
   // Comparisons, per scenario (independent of each other).
   std::vector<double> compare_costs;

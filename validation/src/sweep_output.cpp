@@ -506,4 +506,16 @@ void write_sweep(const std::filesystem::path& dir, const SweepResult& result) {
   if (!message.empty()) throw plot::PlotError(message);
 }
 
+std::string sweep_measured_nothing(const SweepResult& result) {
+  if (result.points.empty()) return "no point was run";
+  std::size_t diverged = 0, failed = 0;
+  for (const SweepPoint& p : result.points) {
+    if (usable(p)) return {};
+    diverged += p.status == RunStatus::Diverged ? 1 : 0;
+    failed += p.status == RunStatus::Diverged ? 0 : 1;
+  }
+  return "every point diverged or failed (" + std::to_string(diverged) + " diverged, " + std::to_string(failed) +
+         " failed): no speed or error was measured";
+}
+
 }  // namespace physval

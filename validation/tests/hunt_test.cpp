@@ -316,8 +316,223 @@ TEST(Hunt, CoreMeetsTheSlowStrikeOnAFrictionlessBallClosedForm) {
 // frictionless_into_row_at_wall (hunt4, open): a frictionless ball strikes (e 0) a ball at
 // rest against a wall; it must stop dead, core sends it back at half the rest speed (the
 // micro-bounce's minimum separation) and, frictionless, it slides away for ever (5 mm at 2 s).
-TEST(Hunt, DISABLED_CoreMeetsTheFrictionlessStrikerIntoARowAtAWallClosedForm) {
+TEST(Hunt, CoreMeetsTheFrictionlessStrikerIntoARowAtAWallClosedForm) {
   expect_core_meets("frictionless_into_row_at_wall.toml");
+}
+
+// The same scene over a grid: a frictionless striker (radius 0.05 m) at u meets a row of
+// 1-3 touching balls at rest on a floor, the last touching a wall, at t_hit (inside a
+// step). Closed form (Newton's law at every contact at once; core's collapse threshold: an
+// impact closing slower than v_r = g dt / 16 is perfectly inelastic): the row is backed by
+// the wall, so it never moves; the striker leaves at -e' u, e' = e (0 below v_r), and slides
+// back on the frictionless floor for ever. Speeds 0.01-2 m/s, striker:row masses 1:1,
+// 1:1000, 1000:1, e 0 and 0.5, dt 1/60 and 1/240, the row with friction 0.5 or none,
+// every numbering of the bodies (24 for a row of 3) and the mirror image.
+struct RowAtWall {
+  int n = 1;
+  double u = 1.0, m_striker = 1.0, m_row = 1.0, e = 0.0, dt = 1.0 / 60.0, row_mu = 0.5;
+  bool mirror = false;
+};
+
+Scene row_at_wall_scene(const RowAtWall& c, const std::vector<std::size_t>& order, double& t_hit) {
+  const double r = 0.05, x_wall = 0.5, sx = c.mirror ? -1.0 : 1.0;
+  Scene s;
+  s.name = "row_at_wall";
+  s.dt = c.dt;
+  s.duration = 2.0;
+  s.world.gravity = {0.0, -9.8};
+  t_hit = 0.5 + 0.37 * c.dt;
+  std::vector<BodyDef> listed;
+  const double x_first = x_wall - r - 2.0 * r * (c.n - 1);
+  BodyDef striker = circle("s", {sx * (x_first - 2.0 * r - c.u * t_hit), r}, r, c.m_striker);
+  striker.velocity = {sx * c.u, 0.0};
+  listed.push_back(striker);
+  for (int k = 0; k < c.n; ++k) {
+    listed.push_back(circle("b" + std::to_string(k), {sx * (x_first + 2.0 * r * k), r}, r, c.m_row));
+  }
+  for (BodyDef& b : listed) b.restitution = c.e;
+  s.bodies.clear();
+  for (std::size_t k : order) s.bodies.push_back(listed[k]);
+  WallDef floor;
+  floor.name = "floor";
+  floor.from = {-50.0, 0.0};
+  floor.to = {50.0, 0.0};
+  floor.material.restitution = c.e;
+  WallDef end;
+  end.name = "end";
+  end.from = {sx * x_wall, 0.0};
+  end.to = {sx * x_wall, 3.0 * r};
+  end.material.restitution = c.e;
+  s.walls = {floor, end};
+  for (const BodyDef& b : listed) {
+    const double mu = b.name == "s" ? 0.0 : c.row_mu;
+    for (const char* w : {"floor", "end"}) {
+      MaterialOverride m;
+      m.a = b.name;
+      m.b = w;
+      m.friction = mu;
+      m.static_friction = mu;
+      s.materials.push_back(m);
+    }
+  }
+  return s;
+}
+
+// Not yet met (the DISABLED_ test below): a row of 2-3 balls with floor friction, struck at
+// e = 0.5 or by a striker 1000 times lighter than the row. A ball at rest with friction takes
+// part in a touching set with its faces only (simultaneous_impacts.cpp: `leaf`, so that a set
+// does not spread through a pile at rest), so the impulse crosses the row pair by pair: at
+// e = 0.5 core gives the sequential law's answer (equal masses, 2 balls: the striker leaves
+// at -0.0656 m/s for 0.3 m/s, where Newton's law at every contact at once gives -0.15 m/s);
+// and a light striker that shared its momentum with the first ball is met again by it at the
+// same instant, pressed by that ball's friction deceleration before the ball's own impact on
+// the next one is resolved, and is sent back at a micro-bounce's minimum separation.
+bool row_at_wall_open(const RowAtWall& c) {
+  return c.row_mu > 0.0 && c.n >= 2 && (c.e > 0.0 || c.m_striker < c.m_row);
+}
+
+void expect_row_at_wall_grid(bool open) {
+  const EngineFactory* core = reference_engine();
+  ASSERT_NE(core, nullptr);
+  int runs = 0, bounced = 0, failures = 0;
+  for (int n : {1, 2, 3}) {
+    for (double u : {0.01, 0.05, 0.3, 2.0}) {
+      for (const auto& [ms, mr] : {std::pair{1.0, 1.0}, std::pair{1.0, 1000.0}, std::pair{1000.0, 1.0}}) {
+        for (double e : {0.0, 0.5}) {
+          for (double dt : {1.0 / 60.0, 1.0 / 240.0}) {
+            for (double row_mu : {0.5, 0.0}) {
+              for (bool mirror : {false, true}) {
+                RowAtWall c{n, u, ms, mr, e, dt, row_mu, mirror};
+                if (row_at_wall_open(c) != open) continue;
+                std::vector<std::size_t> order(static_cast<std::size_t>(n) + 1);
+                for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+                int perm = 0;
+                do {
+                  if (n == 3 && perm++ % 3 != 0) continue;   // 8 of the 24 orders of a row of 3
+                  double t_hit = 0.0;
+                  const Scene scene = row_at_wall_scene(c, order, t_hit);
+                  const RunRecord rec = run_and_compare(scene, *core);
+                  std::string which = "n " + std::to_string(n) + " u " + std::to_string(u) + " m " +
+                                      std::to_string(ms) + ":" + std::to_string(mr) + " e " + std::to_string(e) +
+                                      " dt 1/" + std::to_string(std::lround(1.0 / dt)) + " row mu " +
+                                      std::to_string(row_mu) + (mirror ? " mirrored" : "") + " order";
+                  for (std::size_t k : order) which += " " + std::to_string(k);
+                  std::string wrong;
+                  if (rec.status != RunStatus::Ok) wrong += " status " + rec.reason;
+                  const double vr = 9.8 * dt / 16.0;
+                  const double e_eff = u < vr ? 0.0 : e;
+                  const double sx = mirror ? -1.0 : 1.0;
+                  for (std::size_t slot = 0; slot < order.size(); ++slot) {
+                    const BodyDef& b = scene.bodies[slot];
+                    const BodyState& f = rec.final_states[slot];
+                    Vec2 want_p = b.position, want_v{};
+                    if (b.name == "s") {
+                      const double x_hit = b.position.x + b.velocity.x * t_hit;
+                      want_v = {-sx * e_eff * u, 0.0};
+                      want_p = {x_hit + want_v.x * (scene.duration - t_hit), b.position.y};
+                    }
+                    const double off = std::max(length(f.position - want_p), length(f.velocity - want_v));
+                    if (!(off <= 1e-9)) {
+                      wrong += " " + b.name + " at (" + std::to_string(f.position.x) + ", " +
+                               std::to_string(f.position.y) + ") v (" + std::to_string(f.velocity.x) + ", " +
+                               std::to_string(f.velocity.y) + "), off " + std::to_string(off);
+                    }
+                  }
+                  if (!wrong.empty() && ++failures <= 30) ADD_FAILURE() << which << ":" << wrong;
+                  if (e_eff > 0.0) ++bounced;
+                  ++runs;
+                } while (std::next_permutation(order.begin(), order.end()));
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  EXPECT_EQ(failures, 0) << "of " << runs << " runs";
+  EXPECT_GT(runs, 0);
+  if (!open) {
+    // a row of 1: 192 cases x 2 orders; rows of 2 and 3: the 96 frictionless cases and the
+    // 32 with friction at e 0 and a striker not lighter, x 6 and 8 orders
+    EXPECT_EQ(runs, 192 * 2 + 128 * (6 + 8));
+    EXPECT_GT(bounced, 0);
+  }
+}
+
+TEST(Hunt, CoreMeetsTheStrikerIntoARowAtAWallClosedFormOverAGrid) { expect_row_at_wall_grid(false); }
+
+TEST(Hunt, DISABLED_CoreMeetsTheStrikerIntoARowAtAWallClosedFormOverTheOpenPartOfTheGrid) {
+  expect_row_at_wall_grid(true);
+}
+
+// row_at_wall_unproven_hold (hunt4, a false alarm): a 1000 kg frictionless ball struck (e 0)
+// into a row of three at rest against a wall: all four end at rest, exactly. In 2 of 8
+// numberings the braced-group judgement's Gauss-Seidel left a member 4e-5 m/s^2 and its exact
+// least-squares fallback found forces leaving every member at 1.5e-14 m/s^2, but only a
+// certificate of collapse was looked for there, so the run was `diverged` ("could not show").
+// Fixed: forces >= 0 from the exact solve that leave every member at rest hold it
+// (resting_contact.cpp, component_holds). Every order of the four bodies and the mirror
+// image (48 runs) must be `ok` and meet the closed form.
+TEST(Hunt, CoreHoldsTheRowStruckIntoAWallInEveryNumbering) {
+  const EngineFactory* core = reference_engine();
+  ASSERT_NE(core, nullptr);
+  const ScenarioLoad l =
+      load_scenario_file(std::string(PHYSVAL_SOURCE_DIR) + "/validation/tests/hunt/row_at_wall_unproven_hold.toml");
+  ASSERT_TRUE(l.scene.has_value());
+  ASSERT_EQ(l.scene->bodies.size(), 4u);
+  int runs = 0;
+  for (bool mirror : {false, true}) {
+    Scene scene = *l.scene;
+    if (mirror) {
+      for (BodyDef& b : scene.bodies) {
+        b.position.x = -b.position.x;
+        b.velocity.x = -b.velocity.x;
+      }
+      for (WallDef& w : scene.walls) {
+        w.from.x = -w.from.x;
+        w.to.x = -w.to.x;
+      }
+    }
+    scene.expect = {};
+    const std::vector<BodyDef> listed = scene.bodies;
+    std::vector<std::size_t> order{0, 1, 2, 3};
+    do {
+      for (std::size_t k = 0; k < order.size(); ++k) scene.bodies[k] = listed[order[k]];
+      const RunRecord r = run_and_compare(scene, *core);
+      std::string which = mirror ? "mirrored, order" : "order";
+      for (std::size_t k : order) which += " " + std::to_string(k);
+      EXPECT_EQ(r.status, RunStatus::Ok) << which << ": " << r.reason;
+      for (std::size_t k = 0; k < order.size(); ++k) {
+        const BodyDef& b = scene.bodies[k];
+        // b0 (the striker) moves 0.01 m to the row; the rest never move; all end at rest
+        const double x = b.name == "b0" ? b.position.x + (mirror ? -0.01 : 0.01) : b.position.x;
+        EXPECT_NEAR(r.final_states[k].position.x, x, 1e-9) << which << " " << b.name;
+        EXPECT_NEAR(r.final_states[k].position.y, b.position.y, 1e-9) << which << " " << b.name;
+        EXPECT_EQ(r.final_states[k].velocity, (Vec2{0.0, 0.0})) << which << " " << b.name;
+      }
+      ++runs;
+    } while (std::next_permutation(order.begin(), order.end()));
+  }
+  EXPECT_EQ(runs, 48);
+}
+
+// last_step_hold: a hold made inside the run's last step was never judged (holds made inside
+// a step are judged at the next step's start), so a pyramid rigid Coulomb cannot hold, held
+// in a run of one step, was `ok`; a longer run is `diverged` at t = 1/60 s. Fixed: the last
+// step's holds are judged at its end (core_engine.cpp).
+TEST(Hunt, CoreJudgesAHoldMadeInTheLastStep) {
+  const EngineFactory* core = reference_engine();
+  ASSERT_NE(core, nullptr);
+  const ScenarioLoad l =
+      load_scenario_file(std::string(PHYSVAL_SOURCE_DIR) + "/validation/tests/hunt/last_step_hold.toml");
+  ASSERT_TRUE(l.scene.has_value());
+  for (double duration : {l.scene->duration, 0.05}) {
+    Scene scene = *l.scene;
+    scene.duration = duration;
+    const RunRecord r = run_and_compare(scene, *core);
+    EXPECT_EQ(r.status, RunStatus::Diverged) << duration << ": " << r.reason;
+    EXPECT_NE(r.reason.find("'top' at t = 0.0166667 s"), std::string::npos) << r.reason;
+  }
 }
 
 // pyramid_of_three: two balls on a frictionless floor and one on top: they must collapse

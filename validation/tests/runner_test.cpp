@@ -2,13 +2,18 @@
 // (exact flight, a crash, an exception, a NaN, a hang, an energy gain) is known exactly.
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <unistd.h>
+
 #include <csignal>
 #include <cmath>
+#include <fstream>
 #include <thread>
 
 #include "physval/validation/comparator.hpp"
 #include "physval/validation/conservation.hpp"
 #include "physval/validation/gate.hpp"
+#include "physval/validation/run_record_io.hpp"
 #include "physval/validation/runner.hpp"
 #include "physval/validation/suite.hpp"
 
@@ -54,7 +59,10 @@ class FakeEngine final : public Engine {
     }
   }
   const std::vector<ContactEvent>& contacts() const override { return events_; }
-  std::vector<Setting> settings() const override { return {{"fault", std::to_string(static_cast<int>(fault_))}}; }
+  // The process it ran in (settings are read in the engine's process), for the worker tests.
+  std::vector<Setting> settings() const override {
+    return {{"fault", std::to_string(static_cast<int>(fault_))}, {"pid", std::to_string(::getpid())}};
+  }
 
  private:
   Fault fault_;
@@ -158,6 +166,154 @@ TEST(Runner, HangIsStoppedByTheTimeout) {
   const RunRecord r = run_engine_isolated(two_bodies(), fake(Fault::Hang), o);
   EXPECT_EQ(r.status, RunStatus::Error);
   EXPECT_NE(r.reason.find("timed out"), std::string::npos) << r.reason;
+}
+
+// --- Run workers: one long-lived child per thread takes its runs one after another --
+
+std::string pid_of(const RunRecord& r) {
+  for (const auto& [k, v] : r.settings) {
+    if (k == "pid") return v;
+  }
+  return "";
+}
+
+// The record's bytes without what may differ between processes: timings and the pid.
+std::vector<std::uint8_t> comparable(RunRecord r) {
+  r.wall_seconds = r.load_seconds = r.step_cpu_seconds = 0.0;
+  for (auto& [k, v] : r.settings) {
+    if (k == "pid") v.clear();
+  }
+  return encode_run_record(r);
+}
+
+// Waits until the (killed) process is a zombie or gone: its parent has not reaped it.
+void wait_until_dead(pid_t pid) {
+  for (int i = 0; i < 400; ++i) {
+    std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+    std::string line;
+    if (!std::getline(stat, line)) return;
+    const std::size_t close = line.rfind(')');
+    if (close != std::string::npos && close + 2 < line.size() && line[close + 2] == 'Z') return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+}
+
+TEST(RunWorkers, RunsOneAfterAnotherInOneProcessWithTheRecordsOfInProcessRuns) {
+  const Scene a = two_bodies();
+  Scene b = two_bodies();
+  b.name = "shorter";
+  b.duration = 0.55;
+  const EngineFactory ok = fake(Fault::None);
+  const RunOptions o;
+  pid_t worker = 0;
+  {
+    RunWorkers workers({&a, &b}, {&ok});
+    const RunRecord r1 = workers.run(0, ok, o);
+    const RunRecord r2 = workers.run(1, ok, o);
+    const RunRecord r3 = workers.run(0, ok, o);
+    for (const RunRecord* r : {&r1, &r2, &r3}) ASSERT_EQ(r->status, RunStatus::Ok) << r->reason;
+    EXPECT_EQ(r2.steps, 55);
+    // One worker took all three: a process of its own, not this one.
+    ASSERT_FALSE(pid_of(r1).empty());
+    EXPECT_EQ(pid_of(r1), pid_of(r2));
+    EXPECT_EQ(pid_of(r1), pid_of(r3));
+    EXPECT_NE(pid_of(r1), std::to_string(::getpid()));
+    // Each record is the one an in-process run gives (the same scene run twice too).
+    EXPECT_EQ(comparable(r1), comparable(run_engine(a, ok, o)));
+    EXPECT_EQ(comparable(r2), comparable(run_engine(b, ok, o)));
+    EXPECT_EQ(comparable(r3), comparable(r1));
+    // Each run is charged the worker's CPU it cost.
+    EXPECT_GT(r1.child_cpu_seconds, 0.0);
+    EXPECT_GT(r2.child_cpu_seconds, 0.0);
+    worker = static_cast<pid_t>(std::stol(pid_of(r1)));
+    EXPECT_EQ(::kill(worker, 0), 0) << "the worker lives between runs";
+  }
+  // The destructor ended and reaped it (a zombie would still answer kill 0).
+  EXPECT_NE(::kill(worker, 0), 0) << "worker " << worker << " outlived its RunWorkers";
+}
+
+TEST(RunWorkers, ACrashAHangOrAnExceptionCostsOnlyItsOwnRun) {
+  const Scene s = two_bodies();
+  const EngineFactory ok = fake(Fault::None), crash = fake(Fault::Crash), hang = fake(Fault::Hang),
+                      thrower = fake(Fault::Throw);
+  const RunOptions o;
+  RunWorkers workers({&s}, {&ok, &crash, &hang, &thrower});
+  const RunRecord first = workers.run(0, ok, o);
+  ASSERT_EQ(first.status, RunStatus::Ok) << first.reason;
+
+  // A crash: the reason an isolated run gives, and the next run has a new worker.
+  const RunRecord crashed = workers.run(0, crash, o);
+  EXPECT_EQ(crashed.status, RunStatus::Error);
+  EXPECT_EQ(crashed.reason, run_engine_isolated(s, crash, o).reason);
+  EXPECT_TRUE(crashed.reason.find("signal") != std::string::npos ||
+              crashed.reason.find("exited with status") != std::string::npos)
+      << crashed.reason;
+  EXPECT_GT(crashed.child_cpu_seconds, 0.0);
+  const RunRecord after_crash = workers.run(0, ok, o);
+  ASSERT_EQ(after_crash.status, RunStatus::Ok) << after_crash.reason;
+  EXPECT_NE(pid_of(after_crash), pid_of(first));
+  EXPECT_EQ(comparable(after_crash), comparable(first));
+
+  // A hang: stopped at the timeout, as an isolated run is.
+  RunOptions limited = o;
+  limited.timeout_seconds = 0.5;
+  const RunRecord hung = workers.run(0, hang, limited);
+  EXPECT_EQ(hung.status, RunStatus::Error);
+  EXPECT_EQ(hung.reason, "timed out after 0.5 s");
+  const RunRecord after_hang = workers.run(0, ok, limited);
+  ASSERT_EQ(after_hang.status, RunStatus::Ok) << after_hang.reason;
+  EXPECT_NE(pid_of(after_hang), pid_of(after_crash));
+
+  // An exception is the run's error; the worker goes on.
+  const RunRecord threw = workers.run(0, thrower, o);
+  EXPECT_EQ(threw.status, RunStatus::Error);
+  EXPECT_EQ(threw.reason, run_engine(s, thrower, o).reason);
+  const RunRecord after_throw = workers.run(0, ok, o);
+  ASSERT_EQ(after_throw.status, RunStatus::Ok) << after_throw.reason;
+  EXPECT_EQ(pid_of(after_throw), pid_of(after_hang));
+}
+
+TEST(RunWorkers, AWorkerKilledWhileIdleIsReplaced) {
+  const Scene s = two_bodies();
+  const EngineFactory ok = fake(Fault::None);
+  RunWorkers workers({&s}, {&ok});
+  const RunRecord first = workers.run(0, ok, RunOptions{});
+  ASSERT_EQ(first.status, RunStatus::Ok) << first.reason;
+  const auto pid = static_cast<pid_t>(std::stol(pid_of(first)));
+  ASSERT_EQ(::kill(pid, SIGKILL), 0);
+  wait_until_dead(pid);
+  const RunRecord next = workers.run(0, ok, RunOptions{});
+  ASSERT_EQ(next.status, RunStatus::Ok) << next.reason;
+  EXPECT_NE(pid_of(next), pid_of(first));
+  EXPECT_EQ(comparable(next), comparable(first));
+}
+
+TEST(RunWorkers, EachThreadHasAWorkerOfItsOwnAndAnUnlistedEngineAChildOfItsOwn) {
+  const Scene s = two_bodies();
+  const EngineFactory ok = fake(Fault::None), unlisted = fake(Fault::None);
+  RunWorkers workers({&s}, {&ok});
+  std::string pids[2][2];
+  std::vector<std::uint8_t> bytes[2][2];
+  std::thread threads[2];
+  for (int t = 0; t < 2; ++t) {
+    threads[t] = std::thread([&, t] {
+      for (int k = 0; k < 2; ++k) {
+        const RunRecord r = workers.run(0, ok, RunOptions{});
+        pids[t][k] = r.status == RunStatus::Ok ? pid_of(r) : "failed: " + r.reason;
+        bytes[t][k] = comparable(r);
+      }
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  EXPECT_EQ(pids[0][0], pids[0][1]);
+  EXPECT_EQ(pids[1][0], pids[1][1]);
+  EXPECT_NE(pids[0][0], pids[1][0]);
+  EXPECT_EQ(bytes[0][0], bytes[1][1]);
+  const RunRecord own = workers.run(0, unlisted, RunOptions{});
+  ASSERT_EQ(own.status, RunStatus::Ok) << own.reason;
+  EXPECT_NE(pid_of(own), pids[0][0]);
+  EXPECT_NE(pid_of(own), pids[1][0]);
+  EXPECT_NE(pid_of(own), std::to_string(::getpid()));
 }
 
 TEST(Comparator, EnergyRunawayIsDiverged) {

@@ -6,10 +6,25 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 
 #include "physval/validation/comparator.hpp"
 
 namespace physval {
+
+// A 128-bit hash of bytes (hex, 32 digits): cache entries' seals, file identities.
+std::string hash_file_bytes(std::string_view bytes);
+
+// The hash of the running physval executable's bytes (computed once): any rebuild with
+// other code has another, even at the same version number.
+const std::string& executable_hash();
+
+// The loader notes the text of each scenario file as it read it. The cache key holds the
+// file's text as it is when the reference is keyed; when that is no longer the text the
+// scene was parsed from (the file was edited during the run), the reference is computed
+// from the scene as loaded and neither read from nor stored in the cache: stored under
+// the edited text, it would be served later as the edited scene's reference.
+void note_loaded_scenario_text(const std::string& file, const std::string& text);
 
 // $XDG_CACHE_HOME/physval/references, else ~/.cache/physval/references.
 std::filesystem::path default_reference_cache_dir();

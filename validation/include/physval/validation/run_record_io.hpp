@@ -31,5 +31,9 @@ struct RecordTimeout : std::runtime_error {
 // stream. `bytes_read` says how much arrived (0: the writer sent nothing).
 RunRecord read_run_record(int fd, std::optional<std::chrono::steady_clock::time_point> deadline,
                           std::size_t& bytes_read);
+// The same, then one double the writer sent right after the record (a run worker's CPU
+// for the run, see RunWorkers); nothing may follow it.
+RunRecord read_run_record(int fd, std::optional<std::chrono::steady_clock::time_point> deadline,
+                          std::size_t& bytes_read, double& after);
 
 }  // namespace physval

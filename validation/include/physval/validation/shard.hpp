@@ -38,4 +38,12 @@ double scenario_cost(const Scene& effective_scene, std::size_t engine_runs);
 // machines must have run the same scenario files. Empty when the file cannot be read.
 std::string file_fingerprint(const std::string& path);
 
+// What the results were computed with, beyond the options: a hash of the physval
+// executable, every engine of the registry (name, version, precision) and a hash of each
+// plugin library loaded. Shards whose builds differ are not parts of one job (`merge`
+// refuses them): the version number alone stays the same across rebuilds, so a shard
+// folder left from an earlier build (a job whose task died before writing) merged as if
+// it were current, and a machine without the bundled plugins ran fewer engines.
+nlohmann::json build_identity();
+
 }  // namespace physval

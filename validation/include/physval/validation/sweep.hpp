@@ -142,4 +142,10 @@ nlohmann::json sweep_to_json(const SweepResult& result);
 // Throws plot::PlotError when the plots cannot be drawn (after writing CSV and JSON).
 void write_sweep(const std::filesystem::path& dir, const SweepResult& result);
 
+// Why a sweep measured nothing: no point ran whole (every one diverged, failed or timed
+// out), so no speed and no error figure exists; empty when at least one point did. Such
+// a sweep exits 1 (`physval sweep`, `physval merge` of sweep shards): it printed a table
+// of statuses and exited 0 before, as if the figures had been measured.
+std::string sweep_measured_nothing(const SweepResult& result);
+
 }  // namespace physval

@@ -91,6 +91,11 @@ class Engine {
   virtual BodyMeta body_meta(std::size_t i) const = 0;
   // Fills out[i] for every body; resizes out to body_count().
   virtual void read_states(std::vector<BodyState>& out) const = 0;
+  // The same for the runner's containment check after every step, which reads where each
+  // body is, its velocity and whether it is alive only: an engine may leave angle and
+  // angular_velocity as they were (Bullet works the angle out of its rotation matrix with
+  // an atan2 per body). The default reads everything.
+  virtual void read_motion(std::vector<BodyState>& out) const { read_states(out); }
 
   // Contacts that began during the last step().
   virtual const std::vector<ContactEvent>& contacts() const = 0;
