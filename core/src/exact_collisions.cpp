@@ -746,7 +746,22 @@ class EventLoop {
         w_.vel[j] = vj_before;
       }
     }
-    const bool simultaneous = !settled && !isolated && resolve_simultaneous(w_, i, j, t, set_, impacted_, min_sep);
+    if (cycling) cycle_vel_.assign(w_.vel.begin(), w_.vel.end());
+    bool simultaneous = !settled && !isolated && resolve_simultaneous(w_, i, j, t, set_, impacted_, min_sep);
+    if (simultaneous && cycling && set_gained_energy()) {
+      // A zero-time cycle is inelastic collapse (infinitely many impacts in no time, the
+      // gaps at round-off). Its separating contacts may take an impulse (w+ = 0 where
+      // w- > 0), which does positive work p w- / 2: a light ball squeezed between a wall
+      // and a 1e6 times heavier one was held at the wall while the heavy one bounced off
+      // it at their relative speed, 5,800 times the scene's energy. The limit of the
+      // collapse is the perfectly inelastic answer: the same set solved with every
+      // restitution 0, which is the kinetic-energy-norm projection of the velocities onto
+      // w+ >= 0, so it never raises the energy.
+      for (std::uint32_t b : set_) w_.vel[b] = cycle_vel_[b];
+      w_.sim_inelastic = true;
+      simultaneous = resolve_simultaneous(w_, i, j, t, set_, impacted_, min_sep);
+      w_.sim_inelastic = false;
+    }
     w_.sim_with_separating = false;
     if (simultaneous) {
       if (wedged()) ++w_.stats.wedged;
@@ -781,6 +796,19 @@ class EventLoop {
       free_dependents(i, t);
       free_dependents(j, t);
     }
+  }
+
+  // Whether the last simultaneous solve raised its set's kinetic energy beyond round-off
+  // (cycle_vel_: the velocities before it).
+  bool set_gained_energy() const {
+    double before = 0.0, after = 0.0;
+    for (std::uint32_t b : set_) {
+      if (w_.is_static(b) || !(w_.inv_mass[b] > 0.0)) continue;
+      const double m = 1.0 / w_.inv_mass[b];
+      before += 0.5 * m * dot(cycle_vel_[b], cycle_vel_[b]);
+      after += 0.5 * m * dot(w_.vel[b], w_.vel[b]);
+    }
+    return after > before * (1.0 + 1e-12);
   }
 
   // Every body of a touching set resolved at once (resolve_simultaneous): new paths
@@ -890,7 +918,7 @@ class EventLoop {
                resolve_simultaneous(w_, i, kSimultaneousFace | k, t, set_, impacted_)) {
       // Body i touches other bodies or faces at this instant: Newton's law at all of
       // its contacts at once (a ball wedged between a wall and another ball).
-      finish_simultaneous(t, t_abs);
+        finish_simultaneous(t, t_abs);
       return;
     } else {
       resolve_static(w_, i, n_resp, m, slow ? 0.5 * vr : 0.0);
@@ -970,6 +998,7 @@ class EventLoop {
   std::uint32_t face_count_ = 0;     // kManyFaces: ask StaticGeometry every time
   std::vector<std::uint32_t> set_;      // the touching set of a simultaneous impact
   std::vector<BodyPair> impacted_;      // its pairs that took an impulse
+  std::vector<Vec2> cycle_vel_;         // velocities before a cycling set's solve
   std::vector<std::uint32_t> near_;     // bodies near one being held
   std::vector<std::uint32_t> group_;    // a group held at once
   std::vector<std::uint32_t> chain_, moved_;   // a train joined at an impact (join_chain)

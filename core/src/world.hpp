@@ -6,8 +6,8 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
-#include <unordered_map>
 #include <limits>
+#include <unordered_map>
 #include <memory>
 #include <random>
 #include <span>
@@ -133,6 +133,10 @@ struct World {
   // simultaneous set then takes its touching contacts that separate too (the LCP gives
   // them no impulse unless the others' impulses would close them).
   bool sim_with_separating = false;
+  // Set by the event loop to solve such a cycling set again perfectly inelastically (every
+  // contact's restitution 0, collapse_speed infinite) when Newton's law with the
+  // separating contacts would raise its kinetic energy (see exact_collisions.cpp).
+  bool sim_inelastic = false;
   BroadPhaseKind broadphase = BroadPhaseKind::Grid;
   bool broadphase_auto = true;
   double cell_size = 0.0;
@@ -331,6 +335,7 @@ struct World {
   // accelerations. 0 in a scene without forces.
   double step_dt = 0.0;   // the current step's dt (set by apply_supports)
   double collapse_speed(std::uint32_t i, std::uint32_t j) const {
+    if (sim_inelastic) return std::numeric_limits<double>::infinity();
     if (acc.empty() || step_dt == 0.0) return 0.0;
     return rest_speed(std::max(length(acc[i]), length(acc[j])), step_dt);
   }
