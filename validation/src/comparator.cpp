@@ -564,6 +564,30 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
       gain = std::max(gain, g);
       if (conserved.energy_non_increasing && !conserved.energy && g > 1.0 && !gain_at) gain_at = s.time[k];
     }
+    // A bound system cannot come apart. With no uniform field the energy's zero is not a
+    // convention: kinetic energy >= 0 and the Newtonian potential -> 0 as bodies separate.
+    // In a scene that conserves or only loses energy, E(0) < 0 means E(t) < 0 for ever: a
+    // run whose energy crossed 0 and stayed above it to its end gained more than the whole
+    // binding energy (a binary blown apart by a close pass), however small that is next
+    // to the scene's energy scale (set by the pass's peak kinetic energy). A crossing that
+    // comes back below 0 (an integrator's error at periapsis) is left to energy_drift.
+    const bool bound_zero = (conserved.energy || conserved.energy_non_increasing) && scene.world.newtonian &&
+                            scene.world.gravity.x == 0.0 && scene.world.gravity.y == 0.0;
+    std::optional<double> unbound_since;
+    if (bound_zero && t0.energy() < 0.0) {
+      const double e0 = t0.energy();
+      for (std::size_t k = 1; k < s.totals.size(); ++k) {
+        const double e = s.totals[k].energy();
+        if (std::isnan(e)) continue;
+        // Above 0 by more than round-off of the scene's scale (a marginally bound pair).
+        if (e > 1e-12 * scales.energy && e - e0 > 1e-12 * scales.energy) {
+          if (!unbound_since) unbound_since = s.time[k];
+        } else {
+          unbound_since.reset();
+        }
+      }
+      if (unbound_since) run.unbound_ratio = s.totals.back().energy() / std::abs(e0);
+    }
     if (conserved.energy_non_increasing && !conserved.energy) run.metrics["energy_gain"] = gain;
     if (conserved.energy) run.metrics["energy_drift"] = de;
     if (conserved.linear_momentum) run.metrics["linear_momentum_drift"] = dp;
@@ -577,6 +601,24 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
     // A blow-up in a scene that can only lose energy (friction, drag, e < 1) is found
     // without a reference: a reference of a chaotic pile does not converge, and an engine
     // whose bodies fly apart must still not be ok.
+    if (unbound_since && run.unbound_ratio && run.status == RunStatus::Ok) {
+      energy_diverged = true;
+      run.status = RunStatus::Diverged;
+      run.diverged_at = unbound_since;
+      run.reason = "a bound system came apart: its energy went from " + fmt(t0.energy()) + " J to " +
+                   fmt(s.totals.back().energy()) + " J (" + fmt(*run.unbound_ratio) +
+                   " x the binding energy) and stayed above 0 from t = " + fmt(*unbound_since) +
+                   " s; energy is conserved here, or only lost, so it can never cross 0";
+      if (auto known = scene.gate.known_failures.find(run.engine); known != scene.gate.known_failures.end()) {
+        if (auto k = known->second.find("energy_crossed_zero"); k != known->second.end()) {
+          run.known_divergence = *run.unbound_ratio <= k->second;
+          run.reason += run.known_divergence ? "; a known failure ([gate." + run.engine + "] accepts up to " +
+                                                   fmt(k->second) + " x)"
+                                             : "; more than the " + fmt(k->second) + " x [gate." + run.engine +
+                                                   "] accepts as known";
+        }
+      }
+    }
     if (gain_at && run.status == RunStatus::Ok) {
       energy_diverged = true;
       run.status = RunStatus::Diverged;

@@ -16,6 +16,8 @@ KnownFailures measured_known_failures(const ScenarioResult& scenario, double mar
     if (r.containment.escaped_bodies && *r.containment.escaped_bodies > 0) {
       known["escaped_bodies"] = *r.containment.escaped_bodies;
     }
+    // A bound system that came apart: E(end) / |E(0)|, with the margin.
+    if (r.status == RunStatus::Diverged && r.unbound_ratio) known["energy_crossed_zero"] = *r.unbound_ratio * margin;
     for (const Check& c : r.checks) {
       if (c.what.rfind("expect.", 0) != 0) continue;
       if (c.pass && !c.known_failure) continue;

@@ -120,6 +120,10 @@ struct RunRecord {
   // [gate.<engine>] known_failures accepts (escaped_bodies = N): still `diverged`, but it
   // passes (a known failure, like a known expectation miss).
   bool known_divergence = false;
+  // A bound system that came apart (energy went from below 0 to above it and stayed there,
+  // in a scene that conserves or only loses energy, with no uniform field): E(end) / |E(0)|.
+  // Not in results.json; the reason says it, --record-known writes it as energy_crossed_zero.
+  std::optional<double> unbound_ratio;
   double wall_seconds = 0.0;           // time inside step() only
   double load_seconds = 0.0;
   // Harness accounting (`physval run --overhead FILE`; not in results.json):
