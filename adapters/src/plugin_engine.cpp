@@ -37,7 +37,33 @@ struct PluginLibrary {
   EngineInfo info;
 };
 
-std::string str(const char* s) { return s == nullptr ? std::string() : std::string(s); }
+// A plugin's text (its error, settings, limits, a broken guarantee) as valid UTF-8: a C
+// library may well write Latin-1 or stray bytes, and results.json, the JUnit file and the
+// report must stay valid, or one engine's message would cost every engine's results. Each
+// byte that does not start a well-formed UTF-8 sequence becomes U+FFFD.
+std::string utf8(const char* s) {
+  std::string out;
+  if (s == nullptr) return out;
+  const auto* p = reinterpret_cast<const unsigned char*>(s);
+  while (*p != 0) {
+    const unsigned char c = *p;
+    int n = c < 0x80 ? 0 : (c >= 0xC2 && c <= 0xDF) ? 1 : (c >= 0xE0 && c <= 0xEF) ? 2 : (c >= 0xF0 && c <= 0xF4) ? 3 : -1;
+    bool ok = n >= 0;
+    for (int k = 1; ok && k <= n; ++k) ok = (p[k] & 0xC0) == 0x80;   // stops at the terminating 0
+    if (ok && n == 2) ok = !(c == 0xE0 && p[1] < 0xA0) && !(c == 0xED && p[1] > 0x9F);   // overlong, surrogates
+    if (ok && n == 3) ok = !(c == 0xF0 && p[1] < 0x90) && !(c == 0xF4 && p[1] > 0x8F);   // overlong, > U+10FFFF
+    if (ok) {
+      out.append(reinterpret_cast<const char*>(p), static_cast<std::size_t>(n + 1));
+      p += n + 1;
+    } else {
+      out += "\xEF\xBF\xBD";
+      ++p;
+    }
+  }
+  return out;
+}
+
+std::string str(const char* s) { return utf8(s); }
 
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
   throw PluginError("plugin " + path + ": " + what);
@@ -418,7 +444,7 @@ class PluginEngine final : public Engine {
   // Asked after every step: an empty answer (the usual one) without measuring it.
   std::string broken_guarantee() const override {
     const char* b = t_.broken_guarantee(engine_);
-    return b == nullptr || *b == '\0' ? std::string() : std::string(b);
+    return b == nullptr || *b == '\0' ? std::string() : utf8(b);
   }
 
  private:

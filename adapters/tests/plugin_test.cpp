@@ -247,6 +247,11 @@ TEST(PluginCli, AFailingStepIsAnErrorWithThePluginsMessage) {
   EXPECT_EQ(run["status"], "error");
   EXPECT_NE(run["reason"].get<std::string>().find("plugin failing: step failed: the solver gave up"), std::string::npos)
       << run.dump();
+  const std::string kReplacement = "\xEF\xBF\xBD";   // U+FFFD
+  // The message is Latin-1 with a stray byte (not UTF-8): results.json stays valid (it was
+  // not written at all, exit 2, every engine's results lost), each bad byte read as U+FFFD.
+  EXPECT_NE(run["reason"].get<std::string>().find(std::string("(r") + kReplacement + "ckw" + kReplacement + "rts " + kReplacement + ")"), std::string::npos)
+      << run.dump();
 }
 
 TEST(PluginCli, LimitsAndABrokenGuaranteeReachTheResults) {
