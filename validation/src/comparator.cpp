@@ -251,6 +251,20 @@ void describe_last(RunRecord& run, const std::string& measured, const std::strin
   run.checks.back().detail = "measured " + measured + ", expected " + expected;
 }
 
+// A divergence the engine's [gate.<engine>] known_failures names (`key` = its bound on
+// `value`): the run stays diverged, and passes as a known failure while within the bound.
+void judge_known_divergence(RunRecord& run, const Scene& scene, const std::string& key, double value,
+                            const std::string& unit) {
+  const auto known = scene.gate.known_failures.find(run.engine);
+  if (known == scene.gate.known_failures.end()) return;
+  const auto k = known->second.find(key);
+  if (k == known->second.end()) return;
+  run.known_divergence = value <= k->second;
+  run.reason += run.known_divergence
+                    ? "; a known failure ([gate." + run.engine + "] accepts up to " + fmt(k->second) + unit + ")"
+                    : "; more than the " + fmt(k->second) + unit + " [gate." + run.engine + "] accepts as known";
+}
+
 // A run diverged only because bodies passed through barriers: its states are still finite
 // and its final state can be held against [expect] (so --record-known sees the real miss).
 bool escaped_only(const RunRecord& run) {
@@ -609,15 +623,7 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
                    fmt(s.totals.back().energy()) + " J (" + fmt(*run.unbound_ratio) +
                    " x the binding energy) and stayed above 0 from t = " + fmt(*unbound_since) +
                    " s; energy is conserved here, or only lost, so it can never cross 0";
-      if (auto known = scene.gate.known_failures.find(run.engine); known != scene.gate.known_failures.end()) {
-        if (auto k = known->second.find("energy_crossed_zero"); k != known->second.end()) {
-          run.known_divergence = *run.unbound_ratio <= k->second;
-          run.reason += run.known_divergence ? "; a known failure ([gate." + run.engine + "] accepts up to " +
-                                                   fmt(k->second) + " x)"
-                                             : "; more than the " + fmt(k->second) + " x [gate." + run.engine +
-                                                   "] accepts as known";
-        }
-      }
+      judge_known_divergence(run, scene, "energy_crossed_zero", *run.unbound_ratio, " x");
     }
     if (gain_at && run.status == RunStatus::Ok) {
       energy_diverged = true;
@@ -683,15 +689,7 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
       run.reason = std::to_string(*c.escaped_bodies) + " of " + std::to_string(scene.bodies.size()) +
                    " bodies passed through a barrier (first " + c.first_escape + " at t = " +
                    fmt(c.first_escape_time.value_or(0.0)) + " s)" + then;
-      if (auto known = scene.gate.known_failures.find(run.engine); known != scene.gate.known_failures.end()) {
-        if (auto k = known->second.find("escaped_bodies"); k != known->second.end()) {
-          run.known_divergence = *c.escaped_bodies <= k->second;
-          run.reason += run.known_divergence ? "; a known failure ([gate." + run.engine + "] accepts up to " +
-                                                   fmt(k->second) + ")"
-                                             : "; more than the " + fmt(k->second) + " [gate." + run.engine +
-                                                   "] accepts as known";
-        }
-      }
+      judge_known_divergence(run, scene, "escaped_bodies", *c.escaped_bodies, "");
     }
   }
 

@@ -66,6 +66,19 @@ std::vector<std::string> failed_checks(const RunRecord& r) {
   return out;
 }
 
+// The failed check of a run the baseline ran and this one did not (unsupported now, or
+// its engine not run at all): every regression the baseline would catch is hidden.
+Check baseline_status_failure(const std::string& before, const std::string& reason) {
+  Check c;
+  c.what = "baseline.status";
+  c.limit = 0.0;
+  c.value.reset();
+  c.pass = false;
+  c.enforced = true;
+  c.detail = "the baseline ran it (status " + before + "); this run did not (" + reason + ")";
+  return c;
+}
+
 }  // namespace
 
 void discard_earlier_junit(const std::string& file) {
@@ -146,16 +159,7 @@ int apply_baseline(SuiteResult& result, const nlohmann::json& baseline, double f
         const nlohmann::json& old_run = *it->second;
         const std::string before = old_run.contains("status") && old_run["status"].is_string()
                                        ? old_run["status"].get<std::string>() : std::string("unsupported");
-        if (before != "unsupported") {
-          Check c;
-          c.what = "baseline.status";
-          c.limit = 0.0;
-          c.value.reset();
-          c.pass = false;
-          c.enforced = true;
-          c.detail = "the baseline ran it (status " + before + "); this run did not (" + r.reason + ")";
-          r.checks.push_back(c);
-        }
+        if (before != "unsupported") r.checks.push_back(baseline_status_failure(before, r.reason));
         continue;
       }
       // A baseline measured at another dt is not this run's: its numbers mean nothing here.
@@ -222,14 +226,7 @@ int add_runs_missing_from_baseline(SuiteResult& result, const nlohmann::json& ba
       r.reason = find_engine(engine) == nullptr
                      ? "not run: no engine named " + engine + " is loaded in this physval (a plugin not found or not given)"
                      : "not run: the scenario's own engines list leaves " + engine + " out";
-      Check c;
-      c.what = "baseline.status";
-      c.limit = 0.0;
-      c.value.reset();
-      c.pass = false;
-      c.enforced = true;
-      c.detail = "the baseline ran it (status " + before + "); this run did not (" + r.reason + ")";
-      r.checks.push_back(std::move(c));
+      r.checks.push_back(baseline_status_failure(before, r.reason));
       sr.runs.push_back(std::move(r));
       ++added;
     }
