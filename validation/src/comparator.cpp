@@ -11,6 +11,7 @@
 #include <sstream>
 #include <string_view>
 #include <unordered_map>
+#include <vector>
 
 #include "physval/adapters/registry.hpp"
 #include "physval/validation/conservation.hpp"
@@ -624,6 +625,61 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
                    " x the binding energy) and stayed above 0 from t = " + fmt(*unbound_since) +
                    " s; energy is conserved here, or only lost, so it can never cross 0";
       judge_known_divergence(run, scene, "energy_crossed_zero", *run.unbound_ratio, " x");
+    }
+    // A bound system's energy scale is its binding energy E_b, not the scene's E_s (the peak
+    // kinetic energy of a close pass sets E_s, and E_s is several x |E(0)| even in a circular
+    // orbit). Where the energy's zero is not a convention (above), the energy the run settles
+    // at, the median of its last quarter (a periapsis pass's transient error, which a
+    // symplectic step gives back, is a small part of it), must stay within E_b / 2 of E(0):
+    // for a two-body orbit, whose semi-major axis a = -G m1 m2 / (2 E) its energy fixes,
+    // a between 2/3 and 2 x the true one. A run that moved further (a Kepler orbit at
+    // periapsis 0.01 m grown from a = 0.5 to 1.6 m; a binary ending 4.5 x tighter after an
+    // intruder's pass) gave another system's answer, whatever its drift against E_s. In a
+    // scene that only loses energy, only a gain counts. Applies with or without a converged
+    // reference, so an unconverged one (chaotic scenes) leaves no bound run unjudged.
+    if (bound_zero && run.status == RunStatus::Ok && s.totals.size() >= 2 && std::isfinite(t0.energy())) {
+      const double e0 = t0.energy();
+      const double eb = binding_energy(scene, e0);
+      const double t_first = s.time.front(), t_last = s.time.back();
+      std::vector<double> tail;
+      for (std::size_t k = 0; k < s.totals.size(); ++k) {
+        const double e = s.totals[k].energy();
+        if (std::isfinite(e) && s.time[k] >= t_first + 0.75 * (t_last - t_first)) tail.push_back(e);
+      }
+      if (eb > 0.0 && !tail.empty()) {
+        std::sort(tail.begin(), tail.end());
+        const std::size_t m = tail.size() / 2;
+        const double settled = tail.size() % 2 == 1 ? tail[m] : 0.5 * (tail[m - 1] + tail[m]);
+        auto judged = [&](double e) { return conserved.energy ? std::abs(e - e0) : e - e0; };
+        const double change = judged(settled);
+        if (change > 0.5 * eb) {
+          // From the sample after which every sample is more than E_b / 2 away (the last
+          // one may be inside a pass's transient: then the tail's first one that is).
+          std::optional<double> since;
+          for (std::size_t k = s.totals.size(); k-- > 0;) {
+            if (!(judged(s.totals[k].energy()) > 0.5 * eb)) break;
+            since = s.time[k];
+          }
+          if (!since) {
+            for (std::size_t k = 0; k < s.totals.size(); ++k) {
+              if (s.time[k] >= t_first + 0.75 * (t_last - t_first) && judged(s.totals[k].energy()) > 0.5 * eb) {
+                since = s.time[k];
+                break;
+              }
+            }
+          }
+          run.binding_change = change / eb;
+          energy_diverged = true;
+          run.status = RunStatus::Diverged;
+          run.diverged_at = since;
+          run.reason = "a bound system's energy settled " + fmt(*run.binding_change) +
+                       " x its binding energy away (more than 1/2): from " + fmt(e0) + " J to " + fmt(settled) +
+                       " J (the median of the run's last quarter), binding energy " + fmt(eb) +
+                       " J; energy is conserved here" + (conserved.energy ? "" : ", or only lost") +
+                       ", and a bound orbit's size is set by it (a = -G m1 m2 / (2 E))";
+          judge_known_divergence(run, scene, "binding_energy_change", *run.binding_change, " x");
+        }
+      }
     }
     if (gain_at && run.status == RunStatus::Ok) {
       energy_diverged = true;
