@@ -630,9 +630,9 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
     // kinetic energy of a close pass sets E_s, and E_s is several x |E(0)| even in a circular
     // orbit). Where the energy's zero is not a convention (above), the energy the run settles
     // at, the median of its last quarter (a periapsis pass's transient error, which a
-    // symplectic step gives back, is a small part of it), must stay within E_b / 2 of E(0):
+    // symplectic step gives back, is a small part of it), must stay within E_b / 4 of E(0):
     // for a two-body orbit, whose semi-major axis a = -G m1 m2 / (2 E) its energy fixes,
-    // a between 2/3 and 2 x the true one. A run that moved further (a Kepler orbit at
+    // a between 0.8 and 1.33 x the true one (the period 0.72-1.54 x). A run that moved further (a Kepler orbit at
     // periapsis 0.01 m grown from a = 0.5 to 1.6 m; a binary ending 4.5 x tighter after an
     // intruder's pass) gave another system's answer, whatever its drift against E_s. In a
     // scene that only loses energy, only a gain counts. Applies with or without a converged
@@ -652,17 +652,17 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
         const double settled = tail.size() % 2 == 1 ? tail[m] : 0.5 * (tail[m - 1] + tail[m]);
         auto judged = [&](double e) { return conserved.energy ? std::abs(e - e0) : e - e0; };
         const double change = judged(settled);
-        if (change > 0.5 * eb) {
-          // From the sample after which every sample is more than E_b / 2 away (the last
+        if (change > 0.25 * eb) {
+          // From the sample after which every sample is more than E_b / 4 away (the last
           // one may be inside a pass's transient: then the tail's first one that is).
           std::optional<double> since;
           for (std::size_t k = s.totals.size(); k-- > 0;) {
-            if (!(judged(s.totals[k].energy()) > 0.5 * eb)) break;
+            if (!(judged(s.totals[k].energy()) > 0.25 * eb)) break;
             since = s.time[k];
           }
           if (!since) {
             for (std::size_t k = 0; k < s.totals.size(); ++k) {
-              if (s.time[k] >= t_first + 0.75 * (t_last - t_first) && judged(s.totals[k].energy()) > 0.5 * eb) {
+              if (s.time[k] >= t_first + 0.75 * (t_last - t_first) && judged(s.totals[k].energy()) > 0.25 * eb) {
                 since = s.time[k];
                 break;
               }
@@ -673,7 +673,7 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
           run.status = RunStatus::Diverged;
           run.diverged_at = since;
           run.reason = "a bound system's energy settled " + fmt(*run.binding_change) +
-                       " x its binding energy away (more than 1/2): from " + fmt(e0) + " J to " + fmt(settled) +
+                       " x its binding energy away (more than 1/4): from " + fmt(e0) + " J to " + fmt(settled) +
                        " J (the median of the run's last quarter), binding energy " + fmt(eb) +
                        " J; energy is conserved here" + (conserved.energy ? "" : ", or only lost") +
                        ", and a bound orbit's size is set by it (a = -G m1 m2 / (2 E))";

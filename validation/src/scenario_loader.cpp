@@ -590,7 +590,7 @@ void read_known_failures(TableReader& r, std::map<std::string, double>& known) {
     }
     if (name == "energy_crossed_zero" || name == "binding_energy_change") {
       // E(end) / |E(0)| of a bound system an engine is known to break up; |E_settled - E(0)| / E_b
-      // of one whose energy it is known to move by more than half the binding energy
+      // of one whose energy it is known to move by more than a quarter of the binding energy
       if (auto b = r.to_number(v, kp)) {
         if (!(*b >= 0.0 && std::isfinite(*b))) {
           r.error_at(v, "known_failures", "the bound for \"" + name + "\" must be a finite number >= 0, got " +

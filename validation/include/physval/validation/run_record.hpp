@@ -125,7 +125,7 @@ struct RunRecord {
   // Not in results.json; the reason says it, --record-known writes it as energy_crossed_zero.
   std::optional<double> unbound_ratio;
   // A bound Newtonian system whose settled energy (the median of the last quarter of the
-  // run) moved from E(0) by more than half its binding energy (conservation.hpp,
+  // run) moved from E(0) by more than a quarter of its binding energy (conservation.hpp,
   // binding_energy): |E_settled - E(0)| / E_b. Not in results.json; the reason says it,
   // --record-known writes it as binding_energy_change.
   std::optional<double> binding_change;
