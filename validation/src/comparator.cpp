@@ -564,6 +564,7 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
   const Scales& scales = cache_->scales_of(scene, reference.run ? &reference.run->series : nullptr);
   const Series& s = run.series;
   bool energy_diverged = false;   // the run's status came from its energy (below)
+  std::optional<double> bound_settled;   // |E_settled - E(0)| / E_b of a bound system judged below
   if (!s.totals.empty()) {
     const Totals& t0 = s.totals.front();
     double de = 0.0, dp = 0.0, dl = 0.0, gain = 0.0;
@@ -652,6 +653,7 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
         const double settled = tail.size() % 2 == 1 ? tail[m] : 0.5 * (tail[m - 1] + tail[m]);
         auto judged = [&](double e) { return conserved.energy ? std::abs(e - e0) : e - e0; };
         const double change = judged(settled);
+        bound_settled = change / eb;
         if (change > 0.25 * eb) {
           // From the sample after which every sample is more than E_b / 4 away (the last
           // one may be inside a pass's transient: then the tail's first one that is).
@@ -706,6 +708,13 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
       run.diverged_at = d.first_energy_excess_time;
       run.reason = "energy ran away from the reference by more than 10 x the scene's energy scale";
     }
+  }
+
+  // A bound system whose reference did not converge (a close encounter is chaotic) was
+  // judged by its energy alone: an ok run says so, and how close to the limit it came.
+  if (run.status == RunStatus::Ok && bound_settled && !(reference.available && reference.converged)) {
+    run.reason = "ok by conservation alone (the reference did not converge): the bound system's energy settled " +
+                 fmt(*bound_settled) + " x its binding energy from E(0) (at most 1/4 allowed)";
   }
 
   // Contact timing: against [expect] contacts when given, else the reference's.
