@@ -11,8 +11,9 @@ closed forms, never against physval's own figures:
   a = -G m1 m2 / (2 E0) and period P = 2 pi sqrt(a^3 / (G (m1 + m2))). The run's a comes from
   its settled energy (median of the last quarter), its period from its positions alone
   (the times between maxima of the separation), and its angular momentum from the series.
-  wrong: it ends unbound, or its a or its period is off by more than 2x (or under 1/2);
-  right: a and period within 10% and angular momentum within 10%.
+  The orbit's size is also taken from the positions alone, (r_max + r_min) / 2 over the last
+  40% of the run. wrong: it ends unbound, or either a or the period is off by more than 2x
+  (or under 1/2); right: both a, the period and the angular momentum within 10%.
 - more bodies: energy is conserved exactly; the scale is the binding energy E_b (-E0, or
   the most bound pair's). wrong: the settled energy moved by more than E_b (or crossed 0 and
   stayed); right: by less than E_b / 10.
@@ -154,16 +155,20 @@ def judge(kind, info, rows, pairs_binding):
         maxima = [t[k] for k in range(1, len(d) - 1) if d[k] > d[k - 1] and d[k] >= d[k + 1]]
         P_run = (maxima[-1] - maxima[0]) / (len(maxima) - 1) if len(maxima) >= 2 else float("nan")
         P_true = 2 * math.pi * math.sqrt(a_true ** 3 / (m1 + m2))
+        # the orbit's size from its positions alone: (r_max + r_min) / 2 over the last 40% of
+        # the run (one period of the 2.5 the scene runs, if the period is right)
+        win = [dd for tt, dd in zip(t, d) if tt >= t[0] + 0.6 * (t[-1] - t[0])]
+        ag = (max(win) + min(win)) / 2 / a_true
         ra_ = a_run / a_true
         rP = P_run / P_true if math.isfinite(P_run) else float("nan")
         dL = abs(L[-1] - L[0]) / abs(L[0])
-        if unbound or not (0.5 <= ra_ <= 2.0) or (math.isfinite(rP) and not (0.5 <= rP <= 2.0)):
+        if unbound or not (0.5 <= ra_ <= 2.0) or not (0.5 <= ag <= 2.0) or (math.isfinite(rP) and not (0.5 <= rP <= 2.0)):
             cls = "wrong"
-        elif abs(ra_ - 1) <= 0.1 and (not math.isfinite(rP) or abs(rP - 1) <= 0.1) and dL <= 0.1:
+        elif abs(ra_ - 1) <= 0.1 and abs(ag - 1) <= 0.1 and (not math.isfinite(rP) or abs(rP - 1) <= 0.1) and dL <= 0.1:
             cls = "right"
         else:
             cls = "grey"
-        return cls, f"a_run/a={ra_:.3g} P_run/P={rP:.3g} dL/L={dL:.2g} E0={E0:.3g} E_settled={Es:.3g}"
+        return cls, f"a_run/a={ra_:.3g} a_geom/a={ag:.3g} P_run/P={rP:.3g} dL/L={dL:.2g} E0={E0:.3g} E_settled={Es:.3g}"
     Eb = max(-E0, pairs_binding)
     change = abs(Es - E0) / Eb if Eb > 0 else float("nan")
     if unbound or change > 1.0:
