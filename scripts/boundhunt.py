@@ -3,7 +3,7 @@
 bound-system rules"; branch boundverdict).
 
 Writes scenes (two-body Kepler orbits at several periapses, eccentricities, steps and mass
-ratios; the built-in close_encounter at several offsets and steps; hierarchical 3-5 body
+ratios, and about a static sun; the built-in close_encounter at several offsets and steps; hierarchical 3-5 body
 systems), runs them with one or two physval binaries and holds every run against the
 closed forms, never against physval's own figures:
 
@@ -68,6 +68,21 @@ def kepler_scene(rp, ra, dt, q, periods=2.5):
     return name, s, {"kind": "kepler", "m1": m1, "m2": m2, "a": a, "P": P}
 
 
+def static_sun_scene(rp, dt, periods=2.5):
+    """A planet of 1e-3 kg about a static sun of 1 kg at the origin (G = 1): the sun's mass
+    attracts through the static body, whose binding is the planet's own energy."""
+    ra = 1.0
+    a = 0.5 * (ra + rp)
+    va = math.sqrt(2.0 * rp / (ra * (ra + rp)))
+    P = 2 * math.pi * math.sqrt(a ** 3)
+    name = ident(f"static_sun_rp{rp:g}_dt{dt:g}")
+    s = f'name = "{name}"\nduration = {fmt(periods * P)}\ndt = {fmt(dt)}\n[world]\nnewtonian = true\nG = 1.0\n'
+    s += '[[bodies]]\nname = "one"\nradius = 0.002\nmass = 1.0\nstatic = true\nposition = [0.0, 0.0]\n'
+    s += body("two", 1e-3, (ra, 0.0), (0.0, va))
+    s += "[gate]\nenergy_drift = 1\n"
+    return name, s, {"kind": "kepler", "m1": 1.0, "m2": 1e-3, "a": a, "P": P, "static": True}
+
+
 def close_encounter_scene(offset, dt):
     name = ident(f"encounter_y{offset:g}_dt{dt:g}")
     s = f'name = "{name}"\nduration = 12.0\ndt = {fmt(dt)}\n[world]\nnewtonian = true\nG = 1.0\nsoftening = 0.01\n'
@@ -116,6 +131,9 @@ def scenes(quick):
         for dt in dts:
             for q in ([1e-3, 1.0] if not quick else [1e-3]):
                 out.append(kepler_scene(rp, 1.0, dt, q))
+    for rp in ([0.3, 0.03, 0.01] if not quick else [0.03]):
+        for dt in dts:
+            out.append(static_sun_scene(rp, dt))
     for offset in ([0.3, 0.5, 0.8, 1.2] if not quick else [0.8]):
         for dt in ([1e-3, 2e-3, 5e-3] if not quick else [2e-3]):
             out.append(close_encounter_scene(offset, dt))
@@ -154,7 +172,7 @@ def judge(kind, info, rows, pairs_binding):
         d = [math.hypot(*v) for v in x]
         maxima = [t[k] for k in range(1, len(d) - 1) if d[k] > d[k - 1] and d[k] >= d[k + 1]]
         P_run = (maxima[-1] - maxima[0]) / (len(maxima) - 1) if len(maxima) >= 2 else float("nan")
-        P_true = 2 * math.pi * math.sqrt(a_true ** 3 / (m1 + m2))
+        P_true = 2 * math.pi * math.sqrt(a_true ** 3 / (m1 if info.get("static") else m1 + m2))
         # the orbit's size from its positions alone: (r_max + r_min) / 2 over the last 40% of
         # the run (one period of the 2.5 the scene runs, if the period is right)
         win = [dd for tt, dd in zip(t, d) if tt >= t[0] + 0.6 * (t[-1] - t[0])]
@@ -191,7 +209,8 @@ def pair_binding(toml_text):
     for blk in toml_text.split("[[bodies]]")[1:]:
         mass = float(re.search(r"mass = ([-0-9.e]+)", blk).group(1))
         p = [float(v) for v in re.search(r"position = \[([^\]]*)\]", blk).group(1).split(",")]
-        v = [float(v) for v in re.search(r"velocity = \[([^\]]*)\]", blk).group(1).split(",")]
+        vm = re.search(r"velocity = \[([^\]]*)\]", blk)
+        v = [float(x) for x in vm.group(1).split(",")] if vm else [0.0, 0.0]
         bl.append((mass, p, v))
     best = 0.0
     for i in range(len(bl)):

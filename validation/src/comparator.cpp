@@ -630,8 +630,9 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
     // A bound system's energy scale is its binding energy E_b, not the scene's E_s (the peak
     // kinetic energy of a close pass sets E_s, and E_s is several x |E(0)| even in a circular
     // orbit). Where the energy's zero is not a convention (above), the energy the run settles
-    // at, the median of its last quarter (a periapsis pass's transient error, which a
-    // symplectic step gives back, is a small part of it), must stay within E_b / 4 of E(0):
+    // at, the median of each quarter of the run (a periapsis pass's transient error, which a
+    // symplectic step gives back, is a small part of it; an orbit kicked to another size at
+    // every pass is not), must stay within E_b / 4 of E(0):
     // for a two-body orbit, whose semi-major axis a = -G m1 m2 / (2 E) its energy fixes,
     // a between 0.8 and 1.33 x the true one (the period 0.72-1.54 x). A run that moved further (a Kepler orbit at
     // periapsis 0.01 m grown from a = 0.5 to 1.6 m; a binary ending 4.5 x tighter after an
@@ -641,46 +642,53 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
     if (bound_zero && run.status == RunStatus::Ok && s.totals.size() >= 2 && std::isfinite(t0.energy())) {
       const double e0 = t0.energy();
       const double eb = binding_energy(scene, e0);
-      const double t_first = s.time.front(), t_last = s.time.back();
-      std::vector<double> tail;
+      const double t_first = s.time.front(), span = s.time.back() - s.time.front();
+      // The run's quarters (a sample on a boundary goes to the later one) and the median of
+      // each one's energies.
+      auto quarter_of = [&](std::size_t k) {
+        return span > 0.0 ? std::min<std::size_t>(3, static_cast<std::size_t>(4.0 * (s.time[k] - t_first) / span)) : 3;
+      };
+      std::vector<double> quarters[4];
       for (std::size_t k = 0; k < s.totals.size(); ++k) {
         const double e = s.totals[k].energy();
-        if (std::isfinite(e) && s.time[k] >= t_first + 0.75 * (t_last - t_first)) tail.push_back(e);
+        if (std::isfinite(e)) quarters[quarter_of(k)].push_back(e);
       }
+      auto judged = [&](double e) { return conserved.energy ? std::abs(e - e0) : e - e0; };
       // Gravity that shapes the motion: a binding below 1e-6 of the scene's scale (two balls
       // moving together in a box at G = 6.674e-11: 6e-11 of it) is swamped by what the
       // contacts do to the total, which cannot say where its error went; energy_drift judges it.
-      if (eb > 1e-6 * scales.energy && !tail.empty()) {
-        std::sort(tail.begin(), tail.end());
-        const std::size_t m = tail.size() / 2;
-        const double settled = tail.size() % 2 == 1 ? tail[m] : 0.5 * (tail[m - 1] + tail[m]);
-        auto judged = [&](double e) { return conserved.energy ? std::abs(e - e0) : e - e0; };
-        const double change = judged(settled);
-        bound_settled = change / eb;
-        if (change > 0.25 * eb) {
-          // From the sample after which every sample is more than E_b / 4 away (the last
-          // one may be inside a pass's transient: then the tail's first one that is).
+      if (eb > 1e-6 * scales.energy) {
+        double change = 0.0, settled = e0;
+        std::size_t worst = 4;
+        for (std::size_t q = 0; q < 4; ++q) {
+          std::vector<double>& v = quarters[q];
+          if (v.empty()) continue;
+          std::sort(v.begin(), v.end());
+          const std::size_t m = v.size() / 2;
+          const double median = v.size() % 2 == 1 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+          if (worst == 4 || judged(median) > change) {
+            change = judged(median);
+            settled = median;
+            worst = q;
+          }
+        }
+        bound_settled = std::max(0.0, change) / eb;
+        if (worst < 4 && change > 0.25 * eb) {
+          // From the quarter's first sample that is more than E_b / 4 away.
           std::optional<double> since;
-          for (std::size_t k = s.totals.size(); k-- > 0;) {
-            if (!(judged(s.totals[k].energy()) > 0.25 * eb)) break;
-            since = s.time[k];
+          for (std::size_t k = 0; k < s.totals.size() && !since; ++k) {
+            if (quarter_of(k) == worst && judged(s.totals[k].energy()) > 0.25 * eb) since = s.time[k];
           }
-          if (!since) {
-            for (std::size_t k = 0; k < s.totals.size(); ++k) {
-              if (s.time[k] >= t_first + 0.75 * (t_last - t_first) && judged(s.totals[k].energy()) > 0.25 * eb) {
-                since = s.time[k];
-                break;
-              }
-            }
-          }
+          const double from = t_first + span * static_cast<double>(worst) / 4.0;
           run.binding_change = change / eb;
           energy_diverged = true;
           run.status = RunStatus::Diverged;
           run.diverged_at = since;
           run.reason = "a bound system's energy settled " + fmt(*run.binding_change) +
                        " x its binding energy away (more than 1/4): from " + fmt(e0) + " J to " + fmt(settled) +
-                       " J (the median of the run's last quarter), binding energy " + fmt(eb) +
-                       " J; energy is conserved here" + (conserved.energy ? "" : ", or only lost") +
+                       " J (the median of the run's quarter from t = " + fmt(from) + " to " + fmt(from + span / 4.0) +
+                       " s), binding energy " + fmt(eb) + " J; energy is conserved here" +
+                       (conserved.energy ? "" : ", or only lost") +
                        ", and a bound orbit's size is set by it (a = -G m1 m2 / (2 E))";
           judge_known_divergence(run, scene, "binding_energy_change", *run.binding_change, " x");
         }
