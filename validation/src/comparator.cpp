@@ -659,13 +659,14 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
       // contacts do to the total, which cannot say where its error went; energy_drift judges it.
       if (eb > 1e-6 * scales.energy) {
         double change = 0.0, settled = e0;
-        std::size_t worst = 4;
+        std::size_t worst = 4, first_beyond = 4;
         for (std::size_t q = 0; q < 4; ++q) {
           std::vector<double>& v = quarters[q];
           if (v.empty()) continue;
           std::sort(v.begin(), v.end());
           const std::size_t m = v.size() / 2;
           const double median = v.size() % 2 == 1 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+          if (first_beyond == 4 && judged(median) > 0.25 * eb) first_beyond = q;
           if (worst == 4 || judged(median) > change) {
             change = judged(median);
             settled = median;
@@ -674,10 +675,10 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
         }
         bound_settled = std::max(0.0, change) / eb;
         if (worst < 4 && change > 0.25 * eb) {
-          // From the quarter's first sample that is more than E_b / 4 away.
+          // From the first sample more than E_b / 4 away in the first quarter that settled so.
           std::optional<double> since;
           for (std::size_t k = 0; k < s.totals.size() && !since; ++k) {
-            if (quarter_of(k) == worst && judged(s.totals[k].energy()) > 0.25 * eb) since = s.time[k];
+            if (quarter_of(k) == first_beyond && judged(s.totals[k].energy()) > 0.25 * eb) since = s.time[k];
           }
           const double from = t_first + span * static_cast<double>(worst) / 4.0;
           run.binding_change = change / eb;
