@@ -222,6 +222,13 @@ TEST_F(BoundSystem, AKnownSettledChangeIsBoundedByItsRatio) {
   EXPECT_NE(text.str().find("known_failures = { \"binding_energy_change\" = 2.22 }"), std::string::npos)
       << text.str() << r.output;
   EXPECT_EQ(physval("gate " + rec.string() + " --engines core --quiet --no-cache --out " + (dir_ / "rec2").string()).status, 0);
+
+  const fs::path bad = write("bad.toml", kepler(0.01, "[gate.core]\nknown_failures = { binding_energy_change = -1 }\n"));
+  const Result b = physval("check " + bad.string());
+  EXPECT_EQ(b.status, 2) << b.output;
+  EXPECT_NE(b.output.find(bad.string() + ":20:"), std::string::npos) << b.output;
+  EXPECT_NE(b.output.find("the bound for \"binding_energy_change\" must be a finite number >= 0"), std::string::npos)
+      << b.output;
 }
 
 }  // namespace
