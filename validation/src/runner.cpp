@@ -3,6 +3,7 @@
 #include "physval/validation/runner.hpp"
 
 #include <fcntl.h>
+#include <malloc.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/prctl.h>
@@ -174,6 +175,56 @@ using StepTicks = std::int64_t;
 inline StepTicks step_ticks() { return std::chrono::steady_clock::now().time_since_epoch().count(); }
 #endif
 
+// Which steps' time inside step() is read (two counter reads around it, and one after the
+// harness's work on it), the rest estimated (README "Harness overhead"): on orbit-sized
+// steps (0.1 us) the two reads a step were half the harness's per-step cost. Every step is
+// timed while the run is short (the first kExactSteps) and while the steps are long (a
+// timed step and its checks took kLongTicks or more: reading then costs 2% at most; stays
+// so until a timed one is short again); otherwise one step in 16, drawn at random (a fixed
+// seed, so no period of the scene's can line up with it). The untimed steps' whole time is
+// known (the loop's ticks less the timed steps' own), and is split between stepping and the
+// harness in the ratio the randomly drawn steps had.
+class StepTiming {
+ public:
+  static constexpr long kExactSteps = 256;
+  static constexpr StepTicks kLongTicks = 4096;
+  // Whether to read the clock around step k (1-based).
+  bool timed(long k) {
+    random_ = false;
+    if (k <= kExactSteps || long_) return true;
+    rng_ ^= rng_ << 13;
+    rng_ ^= rng_ >> 7;
+    rng_ ^= rng_ << 17;
+    random_ = (rng_ & 15) == 0;
+    return random_;
+  }
+  // A timed step: ticks inside step(), and from before it to after the checks that follow.
+  void add(StepTicks in_step, StepTicks whole) {
+    step_ += in_step;
+    whole_ += whole;
+    if (random_) {
+      drawn_step_ += in_step;
+      drawn_whole_ += whole;
+    }
+    long_ = whole >= kLongTicks;
+  }
+  // Ticks inside step() over a loop of `loop` ticks: the timed steps' own, and the rest of
+  // the loop in the drawn steps' ratio (all timed steps' when none was drawn).
+  double step_ticks(StepTicks loop) const {
+    const double rest = loop > whole_ ? static_cast<double>(loop - whole_) : 0.0;
+    const StepTicks num = drawn_whole_ > 0 ? drawn_step_ : step_;
+    const StepTicks den = drawn_whole_ > 0 ? drawn_whole_ : whole_;
+    const double share = den > 0 ? static_cast<double>(num) / static_cast<double>(den) : 0.0;
+    return static_cast<double>(step_) + rest * share;
+  }
+
+ private:
+  std::uint64_t rng_ = 0x9e3779b97f4a7c15ULL;
+  bool random_ = false;
+  bool long_ = false;
+  StepTicks step_ = 0, whole_ = 0, drawn_step_ = 0, drawn_whole_ = 0;
+};
+
 struct ProbeTracker {
   std::size_t body;
   Vec2 around;
@@ -309,14 +360,16 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     const double loop_cpu0 = thread_cpu_seconds();
     const auto loop_t0 = clock::now();
     const StepTicks loop_ticks0 = step_ticks();
-    StepTicks step_ticks_total = 0;
+    StepTiming timing;
     long until_sample = every;   // steps to the next sample: k % every == 0 without a division a step
     double stepped = 0.0;   // the time the steps asked for add up to
     for (long k = 1; k <= n && r.status == RunStatus::Ok; ++k) {
       const double h = k == n ? last_dt : scene.dt;
-      const StepTicks t0 = step_ticks();
+      const bool timed = timing.timed(k);
+      StepTicks t0 = 0, t1 = 0;
+      if (timed) t0 = step_ticks();
       engine->step(h);
-      step_ticks_total += step_ticks() - t0;
+      if (timed) t1 = step_ticks();
       r.steps = k;
       const std::vector<ContactEvent>& events = engine->contacts();
       if (!events.empty()) {
@@ -353,13 +406,14 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
       if (!sampled) engine->read_motion(states);
       containment.observe(t, states);
       update_probes(t, h, true);
+      if (timed) timing.add(t1 - t0, step_ticks() - t0);
     }
     {
       const double loop_cpu = thread_cpu_seconds() - loop_cpu0;
       const StepTicks loop_ticks = step_ticks() - loop_ticks0;
       const double loop_wall = std::chrono::duration<double>(clock::now() - loop_t0).count();
       // The steps' share of the loop's ticks, in seconds of the monotonic clock.
-      wall = loop_ticks > 0 ? loop_wall * static_cast<double>(step_ticks_total) / static_cast<double>(loop_ticks) : 0.0;
+      wall = loop_ticks > 0 ? loop_wall * std::min(1.0, timing.step_ticks(loop_ticks) / static_cast<double>(loop_ticks)) : 0.0;
       r.wall_seconds = wall;
       r.step_cpu_seconds = loop_wall > 0.0 ? std::min(loop_cpu, loop_cpu * wall / loop_wall) : 0.0;
     }
@@ -647,12 +701,26 @@ void close_all_but(int a, int b) {
   close_from_to(b + 1, std::numeric_limits<int>::max());
 }
 
+// glibc gives the top of the heap back to the kernel once more than 128 kB of it is free,
+// and serves blocks from 128 kB up (the threshold grows to the largest freed) by mmap,
+// unmapped on free: a run's series (a block of states a sample) and its record were
+// faulted in page by page again on every run, a fifth of a 200-body gas's harness.
+// Kept instead: the worker holds at most what its largest run needed; blocks above 32 MB
+// are still mapped and unmapped.
+void keep_freed_memory() {
+#if defined(__GLIBC__)
+  ::mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  ::mallopt(M_TRIM_THRESHOLD, 1 << 30);
+#endif
+}
+
 // The worker's life: a request, the run, its record and then the CPU it cost (from the end
 // of the previous run, or the fork), until the parent closes its end. Exit statuses as an
 // isolated run's child: 3 the record could not be written, 4 an exception.
 [[noreturn]] void worker_main(int requests, int records, const std::vector<const Scene*>& scenes,
                               const std::vector<const EngineFactory*>& engines) {
   double mark = 0.0;   // a child's CPU clock starts at 0 at fork
+  keep_freed_memory();
   for (;;) {
     WorkerRequest q{};
     if (!read_exactly(requests, &q, sizeof q)) ::_exit(0);
