@@ -17,7 +17,7 @@ namespace physval {
 // __extension__ says so to -Wpedantic.
 __extension__ typedef unsigned __int128 uint128_for_text;
 
-inline char* to_chars_g12(char* out, char* end, double v) {
+[[gnu::always_inline]] inline char* to_chars_g12(char* out, char* end, double v) {
   auto slow = [&] { return std::to_chars(out, end, v, std::chars_format::general, 12).ptr; };
   const double a = std::fabs(v);
   if (!(a >= 1e-5 && a < 1e11)) return slow();   // also NaN, 0 and infinities
