@@ -270,8 +270,11 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
           if (delta < -std::numbers::pi) delta += 2.0 * std::numbers::pi;
           if (t > 0.0) trackers[k].accumulated += delta;
           trackers[k].last_angle = angle;
-          const int full = static_cast<int>(std::floor(std::abs(trackers[k].accumulated) / (2.0 * std::numbers::pi)));
-          if (full > p.full_revolutions) {
+          // floor(turns) > full_revolutions exactly when turns >= full_revolutions + 1 (an
+          // integer, exact in a double): the floor only when a turn is completed.
+          const double turns = std::abs(trackers[k].accumulated) / (2.0 * std::numbers::pi);
+          if (turns >= static_cast<double>(p.full_revolutions) + 1.0) {
+            const int full = static_cast<int>(std::floor(turns));
             // Interpolate within the step to the moment the angle completed the turn.
             const double target = 2.0 * std::numbers::pi * full;
             const double over = std::abs(trackers[k].accumulated) - target;
@@ -279,7 +282,7 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
             p.last_full_rev_time = t - frac * step_dt;
             p.full_revolutions = full;
           }
-          p.revolutions = std::abs(trackers[k].accumulated) / (2.0 * std::numbers::pi);
+          p.revolutions = turns;
         }
       }
     };
