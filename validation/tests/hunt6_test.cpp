@@ -104,6 +104,17 @@ TEST(Hunt6Containment, APassWithinOneStepInAUniformFieldIsAnEscape) {
     }
   }
   EXPECT_EQ(judged, 54);
+  // Two 1 cm balls rolling on a floor (supported: no fall, the step straight as it is) in
+  // the field through each other at dt 1/60: judged before and still (the field taken out
+  // of a step that never fell must not read as a kink).
+  Scene s = two_balls({0.0, -9.8}, 0.01, 0.01);
+  const double h = 1.0 / 60.0, v = 3.3 * 0.02 / h;
+  s.dt = h;
+  const Vec2 a0{-1.65 * 0.02, 0.6 * 0.02}, b0{0.0, 0.0};
+  ContainmentMonitor m(s);
+  m.start({at(a0, {v, 0.0}), at(b0, {})});
+  m.observe(h, {at(a0 + Vec2{v * h, 0.0}, {v, 0.0}), at(b0, {})});
+  EXPECT_EQ(*m.record().escaped_bodies, 2);
 }
 
 const std::string kFallPass = R"(name = "fall_pass"
