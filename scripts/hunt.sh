@@ -35,7 +35,7 @@
 #   hunt6     scripts/hunt6.py --quick (the sixth hunt's families, small grids): two balls in a
 #             field passing through each other within a step, particles near a moving ball,
 #             drag towards a diagonal wind, thrust tables at their ends, three-body orbits,
-#             core's broad phases
+#             core's broad phases, bodies touching at t = 0
 set -euo pipefail
 build=build
 jobs=$(nproc)

@@ -29,6 +29,9 @@ Families:
              linear and angular momentum drift at least what its own final state shows.
   broadphase a dilute gas of mixed sizes on core with every broad phase and cell size: the
              same final states (all give the same pairs).
+  touching   bodies touching at t = 0 (1 mm-20 m): a ball sliding on a floor it rests on, two
+             balls closing from contact (they swap at once), a ball leaving a wall: closed
+             forms, judged as drag2d.
 
 Exit 1 when any finding (a wrong green, or core/the reference off its closed form), 0 when
 none, 2 on a usage error.
@@ -585,9 +588,73 @@ def judge_broadphase(results, truth, find):
                 find(name, "core", f"ends {worst:.3g} m from the all_pairs run (the same pairs must give the same run)")
 
 
+# ---------------------------------------------------------------- touching at t = 0
+def gen_touching(out, truth, quick):
+    T = 2.0
+    for r in ([0.5] if quick else [0.001, 0.5, 20.0]):
+        for dts_ in ["1/60", "1/7"]:
+            for v in [0.5, 5.0]:
+                # (a) resting exactly on a floor (y = r), sliding frictionless under g
+                name = f"touching_floor_r{r}_v{v}_dt{dts_.replace('/', 'o')}".replace(".", "p")
+                text = f"""name = "{name}"
+duration = {fmt(T)}
+dt = "{dts_}"
+[world]
+gravity = [0.0, {fmt(-G)}]
+[[bodies]]
+name = "a"
+radius = {fmt(r)}
+position = [0.0, {fmt(r)}]
+velocity = [{fmt(v)}, 0.0]
+[[walls]]
+name = "floor"
+from = [-10.0, 0.0]
+to = [{fmt(10.0 + 2 * v * T)}, 0.0]
+"""
+                open(os.path.join(out, name + ".toml"), "w").write(text)
+                truth[name] = dict(family="closed", final={"a": (v * T, r)}, vel={"a": (v, 0.0)}, scale=v * T)
+                # (b) two equal balls touching, closing at t = 0 (e = 1): they swap velocities at once
+                name = f"touching_pair_r{r}_v{v}_dt{dts_.replace('/', 'o')}".replace(".", "p")
+                text = f"""name = "{name}"
+duration = {fmt(T)}
+dt = "{dts_}"
+allow_initial_overlap = false
+[[bodies]]
+name = "a"
+radius = {fmt(r)}
+position = [{fmt(-r)}, 0.0]
+velocity = [{fmt(v)}, 0.0]
+[[bodies]]
+name = "b"
+radius = {fmt(r)}
+position = [{fmt(r)}, 0.0]
+velocity = [{fmt(-v / 2)}, 0.0]
+"""
+                open(os.path.join(out, name + ".toml"), "w").write(text)
+                truth[name] = dict(family="closed", final={"a": (-r - v / 2 * T, 0.0), "b": (r + v * T, 0.0)},
+                                   vel={"a": (-v / 2, 0.0), "b": (v, 0.0)}, scale=v * T)
+                # (c) touching a wall, moving away along its normal and along it
+                name = f"touching_wall_r{r}_v{v}_dt{dts_.replace('/', 'o')}".replace(".", "p")
+                text = f"""name = "{name}"
+duration = {fmt(T)}
+dt = "{dts_}"
+[[bodies]]
+name = "a"
+radius = {fmt(r)}
+position = [{fmt(r)}, 0.0]
+velocity = [{fmt(v)}, {fmt(v)}]
+[[walls]]
+name = "left"
+from = [0.0, {fmt(-100.0 - 2 * v * T)}]
+to = [0.0, {fmt(100.0 + 2 * v * T)}]
+"""
+                open(os.path.join(out, name + ".toml"), "w").write(text)
+                truth[name] = dict(family="closed", final={"a": (r + v * T, v * T)}, vel={"a": (v, v)}, scale=v * T)
+
+
 # ---------------------------------------------------------------- driver
 FAMILIES = {"fallpass": gen_fallpass, "particles": gen_particles, "closed": gen_closed,
-            "threebody": gen_threebody, "broadphase": gen_broadphase}
+            "threebody": gen_threebody, "broadphase": gen_broadphase, "touching": gen_touching}
 
 
 def main(argv):
