@@ -113,14 +113,62 @@ struct StaticBodies {
   }
 };
 
+// The moving scene bodies (circles, alive, not the particle's parent) a particle born at
+// `birth` collides with: each one's path over the particle's flight, t in [t_end - s,
+// t_end], is read backwards from its state at the step's end along its current path
+// (exact when it met nothing in that time), and the particle's ballistic path is held
+// against it. A particle placed without this went inside a moving ball (a trail 0.3 m from
+// a 0.4 m ball crossing its path: young particles 0.09 m from the ball's centre, the run
+// `ok`; core is the only engine with particles, and containment does not follow them).
+// Returns the first body met, or kNoBody.
+constexpr std::uint32_t kNoBody = static_cast<std::uint32_t>(-1);
+
+// (Called after end_paths: every body's clock is at the step's end, its local time 0.)
+std::uint32_t placement_meets_body(const World& w, std::uint32_t parent, std::uint16_t group, Vec2 p, Vec2 v, Vec2 g,
+                                   double s) {
+  if (!(s >= 0.0)) return kNoBody;
+  const Vec2 q = p + s * v + (0.5 * s * s) * g;
+  for (std::uint32_t j = 0; j < w.scene_bodies; ++j) {
+    if (j == parent || !w.alive(j) || w.is_static(j) || !(w.radius[j] > 0.0)) continue;
+    if (!w.response(group, w.group[j]).collide) continue;
+    const double R = w.radius[j];
+    const Vec2 end = w.pos[j];
+    if (length(q - end) < R) return j;   // placed inside it, however it got there
+    if (!(s > 0.0)) continue;
+    const Vec2 b0 = w.pos_at(j, -s), bv = w.vel_at(j, -s);
+    const double speed = length(v - bv) + length(g - w.path_acc(j)) * s;
+    if (length(p - b0) < R) continue;   // born inside it (a parent overlapping it): not this test's
+    if (toi::circle_circle(p - b0, v - bv, g - w.path_acc(j), R, s,
+                           toi::squared_tolerance(w.length_scale + length(p), speed, R)) != toi::kNever) {
+      return j;
+    }
+  }
+  return kNoBody;
+}
+
 void spawn_from(World& w, StaticBodies& statics, EmitterState& e, std::uint16_t emitter, Vec2 p, Vec2 v0, Vec2 g,
                 double s, double birth) {
   thread_local std::vector<std::uint32_t> found;
-  if (placement_meets_barrier(w, statics.of(w), found, w.group[e.parent], p, v0, g, s)) {
-    spawn(w, e, emitter, p, v0, birth);
-  } else {
+  const std::uint16_t group = w.group[e.parent];
+  if (!placement_meets_barrier(w, statics.of(w), found, group, p, v0, g, s) &&
+      placement_meets_body(w, e.parent, group, p, v0, g, s) == kNoBody) {
     spawn(w, e, emitter, p + s * v0 + (0.5 * s * s) * g, v0 + s * g, birth);
+    return;
   }
+  // Late by s from its emission point: unless a moving body has come over that point in
+  // the meantime. Then it starts where it was relative to that body when it was born
+  // (outside it: its impact on it comes in the next step), when the straight way there
+  // from its emission point crosses no barrier and ends inside no other moving body.
+  const std::uint32_t j = placement_meets_body(w, e.parent, group, p, Vec2{}, Vec2{}, 0.0);
+  if (j != kNoBody) {
+    const Vec2 b = w.pos[j] + (p - w.pos_at(j, -s));
+    if (!placement_meets_barrier(w, statics.of(w), found, group, p, b - p, Vec2{}, 1.0) &&
+        placement_meets_body(w, e.parent, group, b, Vec2{}, Vec2{}, 0.0) == kNoBody) {
+      spawn(w, e, emitter, b, v0, birth);
+      return;
+    }
+  }
+  spawn(w, e, emitter, p, v0, birth);
 }
 
 }  // namespace

@@ -807,6 +807,16 @@ void check_references(Context& ctx, const toml::table& root, Scene& s) {
     if (s.bodies[i].is_static && s.bodies[i].thrust.enabled()) {
       ctx.error(where("bodies", i, "thrust"), indexed("bodies", i) + ".thrust", "a static body does not move: it takes no thrust");
     }
+    // Thrust acts along the heading. core keeps every heading (bodies do not spin, lecture
+    // step 6: its angular velocity is always 0), while Box2D, Bullet, Chipmunk and ODE turn
+    // it at the body's angular_velocity: a car with angle 0.3 and angular_velocity 2 went
+    // straight on core (4 m/s along 0.3 rad after 2 s) and round a curve on the other four,
+    // each `ok` and 3.9 m "off" a reference that does not model the key.
+    if (s.bodies[i].thrust.enabled() && s.bodies[i].angular_velocity != 0.0) {
+      ctx.error(where("bodies", i, "angular_velocity"), indexed("bodies", i) + ".angular_velocity",
+                "a body with a thrust table must not spin: core (the reference) keeps its heading, the other "
+                "engines would turn it, and the thrust with it; its angular_velocity must be 0");
+    }
   }
 }
 
