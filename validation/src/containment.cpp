@@ -88,6 +88,34 @@ ContainmentMonitor::ContainmentMonitor(const Scene& scene) : scene_(scene) {
     barrier_hi_.push_back({std::max(b.a.x, b.b.x) + r + 2.0 * eps_, std::max(b.a.y, b.b.y) + r + 2.0 * eps_});
   }
 
+  // The open box, grown from the moving bodies' mean position: each barrier box is left
+  // out by the side of it that leaves the most room around that point (the inside of a
+  // walled box is the box less 2 eps). Only the skip below reads it, and only to skip what
+  // the barrier boxes' own test would skip, so a poor box costs speed, never a check.
+  if (!barriers_.empty() && !moving_.empty()) {
+    Vec2 seed{0.0, 0.0};
+    for (const std::size_t i : moving_) seed = seed + scene.bodies[i].position;
+    seed = seed / static_cast<double>(moving_.size());
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    Vec2 lo{-kInf, -kInf}, hi{kInf, kInf};
+    bool open = std::isfinite(seed.x) && std::isfinite(seed.y);
+    for (std::size_t k = 0; k < barriers_.size() && open; ++k) {
+      const Vec2 blo = barrier_lo_[k], bhi = barrier_hi_[k];
+      // The room each side leaves around the seed (negative: the seed is not beyond it).
+      const double room[4] = {blo.x - seed.x, seed.x - bhi.x, blo.y - seed.y, seed.y - bhi.y};
+      const int side = static_cast<int>(std::max_element(room, room + 4) - room);
+      if (!(room[side] > 0.0)) open = false;   // the seed is inside this box (or it is NaN)
+      else if (side == 0) hi.x = std::min(hi.x, blo.x);
+      else if (side == 1) lo.x = std::max(lo.x, bhi.x);
+      else if (side == 2) hi.y = std::min(hi.y, blo.y);
+      else lo.y = std::max(lo.y, bhi.y);
+    }
+    if (open && lo.x < hi.x && lo.y < hi.y) {
+      open_lo_ = lo;
+      open_hi_ = hi;
+    }
+  }
+
   std::vector<std::string> bg_names(barrier_groups.size()), mg_names(body_groups.size());
   for (const auto& [name, id] : barrier_groups) bg_names[id] = name;
   for (const auto& [name, id] : body_groups) mg_names[id] = name;
@@ -564,6 +592,15 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
       // within eps of it. A body with a remembered landing on some line checks every
       // barrier, so that leaving that line is seen wherever it happens.
       const bool all = on_line_count_[i] != 0;
+      // Inside the open box: beyond one side of every barrier box, so the test below
+      // would skip every barrier (the box is empty when open_lo_ == open_hi_ == 0).
+      if (!all && lo_corner.x > open_lo_.x && hi_corner.x < open_hi_.x && lo_corner.y > open_lo_.y &&
+          hi_corner.y < open_hi_.y) {
+        previous_[i] = p1;
+        previous_velocity_[i] = states[i].velocity;
+        previous_alive_[i] = 1;
+        continue;
+      }
       for (std::uint32_t k = 0; k < barriers_.size(); ++k) {
         if (!all && (hi_corner.x < barrier_lo_[k].x || lo_corner.x > barrier_hi_[k].x ||
                      hi_corner.y < barrier_lo_[k].y || lo_corner.y > barrier_hi_[k].y)) {

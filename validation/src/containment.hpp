@@ -90,6 +90,9 @@ class ContainmentMonitor {
   // Each barrier's bounding box, widened by 2 eps: a body's path whose box misses it
   // can neither touch nor cross it (see observe).
   std::vector<Vec2> barrier_lo_, barrier_hi_;
+  // Few barriers: an open box that overlaps none of the barrier boxes above (for each,
+  // beyond one of its sides); a body whose swept box lies strictly inside it skips them.
+  Vec2 open_lo_{0.0, 0.0}, open_hi_{0.0, 0.0};   // empty unless open_lo_ < open_hi_
   double eps_ = 1e-9;
 
   // A uniform grid over the barriers (used when there are many).
