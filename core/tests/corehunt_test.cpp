@@ -52,9 +52,9 @@ TEST(CoreHunt, SqueezedBilliardCollapsesWithoutGainingEnergy) {
 // over their junction (its centre a few 1e-16 m past the upper piece's end), at rest or
 // moving down, under gravity; both pieces with mu_s, mu_k. Closed form: it stays iff
 // tan(angle) <= mu_s, else s(t) = v0 t + g (sin - mu_k cos) t^2 / 2 (or it stops at
-// v0 / |a| when a < 0). It meets the upper piece's end cap (its centre 4e-16 m past that
-// piece's end), which core does not settle on, and micro-bounces off it, sliding with
-// flights free of friction.
+// v0 / |a| when a < 0). It used to meet the upper piece's end cap (its centre 4e-16 m
+// past that piece's end), which core does not settle on, and micro-bounce off it, sliding
+// with flights free of friction.
 // Returns how many runs reached the event cap (each such run stops as diverged: honest);
 // every other run must meet the closed form.
 int junction_start_grid() {
@@ -110,19 +110,18 @@ int junction_start_grid() {
   return capped;
 }
 
-// Open (the fix is not in): 3 of these 70 runs end ok up to 7.6e-4 m off the closed form
-// (60 degrees mu 0.1; 70 degrees mu 0.1 and 0.577, at rest) and 26 reach the event cap
-// at t = 0. Handing a cap met at a junction to the collinear piece's face (branch
-// corehunt, reverted) made all 70 honest (0 off, 10 caps) but broke balls sliding across
-// the junctions of a floor in pieces under gravity (scripts/hunt.sh junction grid: 16
-// runs reached the cap).
-TEST(CoreHunt, DISABLED_ABodyStartedOnAJunctionOfASlopeIsNeverOkOffTheClosedForm) {
+// Fixed: 3 of these 70 runs ended ok up to 7.6e-4 m off the closed form (60 degrees mu
+// 0.1; 70 degrees mu 0.1 and 0.577, at rest) and 26 reached the event cap at t = 0. A body
+// on a face that reaches an end where a collinear piece continues is handed to that piece
+// (hand_over_support), and another piece on its support's line, or a cap at a junction
+// on it, is no impact for it (on_support_line; resting_contact.cpp).
+TEST(CoreHunt, ABodyStartedOnAJunctionOfASlopeIsNeverOkOffTheClosedForm) {
   junction_start_grid();
 }
 
-// Open: with the above, the rest reach the event cap at t = 0 (a ball supported on the
-// lower piece meets the upper piece's face at its very end again and again at t = 0).
-TEST(CoreHunt, DISABLED_ABodyStartedOnAJunctionOfASlopeNeverReachesTheCap) {
+// (Before: supported on the lower piece, the ball met the upper piece's face at its very
+// end again and again at t = 0; on the upper one, its own end cap.)
+TEST(CoreHunt, ABodyStartedOnAJunctionOfASlopeNeverReachesTheCap) {
   EXPECT_EQ(junction_start_grid(), 0);
 }
 
