@@ -909,6 +909,8 @@ class EventLoop {
       // side the wall order gave; at once it stops in the pocket, where the hold takes it).
       finish_simultaneous(t, t_abs);
       return;
+    } else if (slow && face && !own_support && w_.supported(i) && settle_on_next_face(w_, i, k, n, m)) {
+      // A concave corner: from its face onto the next one (resting_contact.cpp).
     } else if (slow && face && (!w_.supported(i) || own_support)) {
       // Settle: the normal velocity goes (friction impulse included), and the body
       // rests on this face until it is lifted, pulled away or slides off its end.

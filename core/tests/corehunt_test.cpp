@@ -246,7 +246,7 @@ TEST(CoreHunt, ABallStartedOnOrBesideACollinearJunctionMeetsTheClosedForm) {
 // 1 and 4 ulps along B either way), at rest or moving down B, it slides on B; started
 // 0.3 m up A it slides down A, meets B at the pocket (t1, v1) with Newton's law (e = 0)
 // and Coulomb's impulse (vt' = 0 if vt <= mu_s vn, else vt - mu_k vn), then slides on B.
-TEST(CoreHunt, DISABLED_ABallAtOrIntoAConcaveJunctionMeetsTheClosedForm) {
+TEST(CoreHunt, ABallAtOrIntoAConcaveJunctionMeetsTheClosedForm) {
   constexpr double kT = 1.5, kDeg = 3.14159265358979323846 / 180.0;
   int cases = 0, capped = 0, off = 0;
   for (const double degA : {10.0, 30.0, 45.0, 60.0, 80.0}) {
