@@ -38,6 +38,31 @@ Totals compute_totals(const Scene& scene, const std::vector<BodyMeta>& bodies,
   return t;
 }
 
+double binding_energy(const Scene& scene, double initial_energy) {
+  if (!scene.world.newtonian) return 0.0;
+  double binding = std::max(0.0, -initial_energy);
+  const std::size_t n = scene.bodies.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const BodyDef& a = scene.bodies[i];
+    for (std::size_t j = i + 1; j < n; ++j) {
+      const BodyDef& b = scene.bodies[j];
+      if (a.is_static && b.is_static) continue;
+      double kinetic = 0.0;
+      if (a.is_static || b.is_static) {
+        const BodyDef& m = a.is_static ? b : a;
+        kinetic = 0.5 * m.mass * length_squared(m.velocity);
+      } else {
+        const double mu = a.mass * b.mass / (a.mass + b.mass);
+        kinetic = 0.5 * mu * length_squared(a.velocity - b.velocity);
+      }
+      const double e = kinetic + newtonian_potential(scene.world.G, scene.world.softening, a.mass, b.mass,
+                                                     a.position, b.position);
+      if (std::isfinite(e)) binding = std::max(binding, -e);
+    }
+  }
+  return binding;
+}
+
 Conserved conserved_quantities(const Scene& scene) {
   Conserved c;
   const bool has_barriers = !scene.walls.empty() || !scene.boxes.empty() || !scene.surfaces.empty() ||

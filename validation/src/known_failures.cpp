@@ -18,6 +18,9 @@ KnownFailures measured_known_failures(const ScenarioResult& scenario, double mar
     }
     // A bound system that came apart: E(end) / |E(0)|, with the margin.
     if (r.status == RunStatus::Diverged && r.unbound_ratio) known["energy_crossed_zero"] = *r.unbound_ratio * margin;
+    // A bound system whose energy settled more than a quarter of its binding energy away: that
+    // change / the binding energy, with the margin.
+    if (r.status == RunStatus::Diverged && r.binding_change) known["binding_energy_change"] = *r.binding_change * margin;
     for (const Check& c : r.checks) {
       if (c.what.rfind("expect.", 0) != 0) continue;
       if (c.pass && !c.known_failure) continue;

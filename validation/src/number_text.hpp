@@ -17,7 +17,7 @@ namespace physval {
 // __extension__ says so to -Wpedantic.
 __extension__ typedef unsigned __int128 uint128_for_text;
 
-inline char* to_chars_g12(char* out, char* end, double v) {
+[[gnu::always_inline]] inline char* to_chars_g12(char* out, char* end, double v) {
   auto slow = [&] { return std::to_chars(out, end, v, std::chars_format::general, 12).ptr; };
   const double a = std::fabs(v);
   if (!(a >= 1e-5 && a < 1e11)) return slow();   // also NaN, 0 and infinities
@@ -32,11 +32,35 @@ inline char* to_chars_g12(char* out, char* end, double v) {
                                              1000000000000000ULL, 10000000000000000ULL, 100000000000000000ULL};
   // floor(log10 |v|) from the binary exponent (within one; corrected below).
   int exp10 = ((biased - 1023) * 78913) >> 18;
+  static constexpr double kPow10d[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9,
+                                       1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17};
   std::uint64_t n = 0;
   for (int attempt = 0;; ++attempt) {
     if (attempt == 3) return slow();
     const int k = 11 - exp10;                 // n = round(|v| * 10^k), 12 digits
     if (k < 0 || k > 17 || -e >= 127) return slow();
+    // First in double: 10^k (k <= 17 < 23) is exact, so y is |v| 10^k to within half an ulp
+    // of y. Kept only for y < 10^12 < 2^40 (half an ulp 2^-14 at most; a larger y, up to
+    // 10^13 as exp10 is at most one below floor(log10 |v|), only moves exp10 up, and is
+    // above 10^12 - 0.5 by far more than its error): unless y lies within 2^-12 of a half,
+    // y and the exact product round to the same integer (y + 0.5 and the truncations are
+    // exact below 2^52). Near a half the exact 128-bit product below decides.
+    {
+      const double y = a * kPow10d[k];   // < 10^12 x 10 (exp10 at most one too low)
+      const auto whole = static_cast<std::uint64_t>(y);
+      if (std::fabs((y - static_cast<double>(whole)) - 0.5) > 0x1p-12) {
+        n = static_cast<std::uint64_t>(y + 0.5);
+        if (n >= kPow10[12]) {
+          ++exp10;
+          continue;
+        }
+        if (n < kPow10[11]) {
+          --exp10;
+          continue;
+        }
+        break;
+      }
+    }
     const uint128_for_text scaled = static_cast<uint128_for_text>(m) * kPow10[k];   // < 2^53 * 2^57
     const int shift = -e;
     if (shift <= 0) return slow();

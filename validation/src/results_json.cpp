@@ -1,6 +1,9 @@
 #include "physval/validation/results_json.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
+
+#include <cerrno>
 
 #include <algorithm>
 #include <charconv>
@@ -312,6 +315,34 @@ json scene_geometry_json(const ScenarioResult& sr) {
   return json::parse(os.str());
 }
 
+namespace {
+
+// A file of write_results's own folder, made whole in one write: no temporary name and
+// rename as write_file_atomically does, and no ofstream. `physval run` writes into its
+// staging folder, which replaces --out whole once everything is written (README, `run`),
+// so nothing reads a series file half written; the temporary and the rename were most of
+// each small file's syscalls, and the suite writes about 300 of them.
+void write_whole_file(const std::filesystem::path& path, std::string_view text) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) throw std::runtime_error("cannot write " + path.string() + ": " + std::strerror(errno));
+  const char* p = text.data();
+  std::size_t left = text.size();
+  while (left > 0) {
+    const ssize_t put = ::write(fd, p, left);
+    if (put < 0 && errno == EINTR) continue;
+    if (put <= 0) {
+      const int e = put < 0 ? errno : EIO;
+      ::close(fd);
+      throw std::runtime_error("cannot write " + path.string() + ": " + std::strerror(e));
+    }
+    p += put;
+    left -= static_cast<std::size_t>(put);
+  }
+  if (::close(fd) != 0) throw std::runtime_error("cannot write " + path.string() + ": " + std::strerror(errno));
+}
+
+}  // namespace
+
 void write_results(const std::filesystem::path& dir, const SuiteResult& result) {
   // Series first: results.json, written last, is what marks a complete output. The
   // report's scene player draws every body, so the series hold up to this many.
@@ -320,10 +351,12 @@ void write_results(const std::filesystem::path& dir, const SuiteResult& result) 
   std::size_t buffer_capacity = 0;
   for (const ScenarioResult& sr : result.scenarios) {
     const double cpu0 = thread_cpu_seconds();
+    const std::filesystem::path folder = dir / "series" / safe_file_name(sr.scene.name);
+    std::filesystem::create_directories(folder);
     {
       std::ostringstream geometry;
       write_scene_geometry(geometry, sr);
-      write_file_atomically(dir / "series" / safe_file_name(sr.scene.name) / "scene.json", geometry.str());
+      write_whole_file(folder / "scene.json", geometry.str());
     }
     auto write_series = [&](const RunRecord& r, const std::string& label) {
       if (r.series.time.empty()) return;
@@ -377,8 +410,8 @@ void write_results(const std::filesystem::path& dir, const SuiteResult& result) 
         }
         *o++ = '\n';
       }
-      write_file_atomically(dir / "series" / safe_file_name(sr.scene.name) / (safe_file_name(label) + ".csv"),
-                            std::string_view(buffer.get(), static_cast<std::size_t>(o - buffer.get())));
+      write_whole_file(folder / (safe_file_name(label) + ".csv"),
+                       std::string_view(buffer.get(), static_cast<std::size_t>(o - buffer.get())));
     };
     for (const RunRecord& r : sr.runs) write_series(r, r.engine);
     if (sr.reference.run) write_series(*sr.reference.run, "reference");

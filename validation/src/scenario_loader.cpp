@@ -588,10 +588,12 @@ void read_known_failures(TableReader& r, std::map<std::string, double>& known) {
       }
       continue;
     }
-    if (name == "energy_crossed_zero") {   // E(end) / |E(0)| of a bound system an engine is known to break up
+    if (name == "energy_crossed_zero" || name == "binding_energy_change") {
+      // E(end) / |E(0)| of a bound system an engine is known to break up; |E_settled - E(0)| / E_b
+      // of one whose energy it is known to move by more than a quarter of the binding energy
       if (auto b = r.to_number(v, kp)) {
         if (!(*b >= 0.0 && std::isfinite(*b))) {
-          r.error_at(v, "known_failures", "the bound for \"energy_crossed_zero\" must be a finite number >= 0, got " +
+          r.error_at(v, "known_failures", "the bound for \"" + name + "\" must be a finite number >= 0, got " +
                                               format_number(*b));
         } else {
           known[name] = *b;
@@ -602,7 +604,7 @@ void read_known_failures(TableReader& r, std::map<std::string, double>& known) {
     if (name.rfind("expect.", 0) != 0) {
       r.error_at(v, "known_failures",
                  "\"" + name + "\" is not an expectation check (they are named expect.*) nor escaped_bodies "
-                 "nor energy_crossed_zero");
+                 "nor energy_crossed_zero nor binding_energy_change");
       continue;
     }
     if (const auto* s = v.as_string(); s != nullptr && s->get() == "not measured") {

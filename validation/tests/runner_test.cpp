@@ -8,6 +8,7 @@
 #include <csignal>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <thread>
 
 #include "physval/validation/comparator.hpp"
@@ -116,6 +117,86 @@ TEST(Runner, RecordsStepsSamplesContactsAndFinalState) {
   EXPECT_NEAR(r.series.time.back(), 1.0, 1e-12);
   ASSERT_EQ(r.final_states.size(), 2u);
   EXPECT_NEAR(r.final_states[0].position.x, 0.0, 1e-12);
+}
+
+// The clock check after every step (clock_matches_steps): a plugin that keeps its time as
+// k x dt, while the harness sums the steps it gave, drifts apart from the sum by round-off
+// that grows with k. Summed here to 5e7 steps of dt = 1e-3 (a second of plain additions):
+// the two differ by more than the old fixed 1% of a step (an error on an honest clock),
+// and the check accepts them at every step count looked at; a clock 0.1% fast, or ahead by
+// a whole step, an infinite or NaN one, is rejected at each of them (the fast ones once
+// 0.1% of the time is more than 1% of a step).
+TEST(RunnerClock, KTimesDtAtLargeStepCountsIsAcceptedAFastClockIsNot) {
+  for (const double dt : {1e-3, 1.0 / 60.0}) {
+    double stepped = 0.0;
+    double widest = 0.0;   // |k dt - stepped| / dt, largest seen
+    const long n = 50'000'000;
+    for (long k = 1; k <= n; ++k) {
+      stepped += dt;
+      if ((k & 0xFFFF) != 0 && k != n && k > 64) continue;
+      const double t = static_cast<double>(k) * dt;
+      widest = std::max(widest, std::abs(t - stepped) / dt);
+      ASSERT_TRUE(clock_matches_steps(t, stepped, k, dt)) << "dt " << dt << " k " << k << ": " << t << " vs " << stepped;
+      ASSERT_TRUE(clock_matches_steps(stepped, stepped, k, dt));
+      if (k > 10) {   // 0.1% of the time is more than 1% of a step from step 11 on
+        ASSERT_FALSE(clock_matches_steps(t * (1.0 + 1e-3), stepped, k, dt)) << "dt " << dt << " k " << k;
+        ASSERT_FALSE(clock_matches_steps(t * (1.0 - 1e-3), stepped, k, dt)) << "dt " << dt << " k " << k;
+      }
+      if (k < 30'000'000) {
+        ASSERT_FALSE(clock_matches_steps(t + dt, stepped, k, dt)) << "dt " << dt << " k " << k;
+      }
+      ASSERT_FALSE(clock_matches_steps(std::numeric_limits<double>::infinity(), stepped, k, dt));
+      ASSERT_FALSE(clock_matches_steps(std::nan(""), stepped, k, dt));
+    }
+    // What the old check (|t - stepped| <= 0.01 dt) would have called a wrong clock.
+    EXPECT_GT(widest, 0.01) << "dt " << dt;
+  }
+}
+
+// The same through run_engine: an engine whose clock is (steps taken) x dt runs ok, one
+// whose clock runs 0.1% fast is an error naming its clock.
+class CountedClockEngine final : public Engine {
+ public:
+  explicit CountedClockEngine(double rate) : inner_(Fault::None), rate_(rate) {}
+  const EngineInfo& info() const override { return inner_.info(); }
+  void load(const Scene& scene) override {
+    inner_.load(scene);
+    dt_ = scene.dt;
+  }
+  void step(double dt) override {
+    inner_.step(dt);
+    ++steps_;
+  }
+  double time() const override { return rate_ * static_cast<double>(steps_) * dt_; }
+  std::size_t body_count() const override { return inner_.body_count(); }
+  BodyMeta body_meta(std::size_t i) const override { return inner_.body_meta(i); }
+  void read_states(std::vector<BodyState>& out) const override { inner_.read_states(out); }
+  const std::vector<ContactEvent>& contacts() const override { return inner_.contacts(); }
+  std::vector<Setting> settings() const override { return inner_.settings(); }
+
+ private:
+  FakeEngine inner_;
+  double rate_;
+  double dt_ = 0.0;
+  long steps_ = 0;
+};
+
+TEST(RunnerClock, AnEngineCountingStepsTimesDtRunsAFastOneIsAnError) {
+  Scene s = two_bodies();
+  s.dt = 0.1 / 3.0;   // not a binary fraction: k dt and the sum differ in the last bits
+  s.duration = 3000 * s.dt;
+  for (const double rate : {1.0, 1.0 + 1e-3}) {
+    EngineFactory f = fake(Fault::None);
+    f.create = [rate] { return std::make_unique<CountedClockEngine>(rate); };
+    const RunRecord r = run_engine(s, f, RunOptions{});
+    if (rate == 1.0) {
+      EXPECT_EQ(r.status, RunStatus::Ok) << r.reason;
+      EXPECT_EQ(r.steps, 3000);
+    } else {
+      EXPECT_EQ(r.status, RunStatus::Error);
+      EXPECT_NE(r.reason.find("reports its time as"), std::string::npos) << r.reason;
+    }
+  }
 }
 
 TEST(Runner, SampleIntervalFromScenarioAndMemoryBound) {

@@ -32,6 +32,14 @@ struct Conserved {
 // [conserves] table overrides each.
 Conserved conserved_quantities(const Scene& scene);
 
+// The binding energy of the scene's bound Newtonian system, from its initial state (J):
+// the largest of -E(0) (the whole system, when E(0) < 0, `initial_energy`) and of every
+// bound pair's -(1/2 mu |vi - vj|^2 + U_ij) (a moving body and a static one: mu = m of the
+// moving body). A binary that is bound while the whole scene is not (an intruder with more
+// kinetic energy than the binary's binding; a binary whose centre of mass moves) has its
+// own. 0 when the scene is not Newtonian or nothing in it is bound.
+double binding_energy(const Scene& scene, double initial_energy);
+
 // Characteristic values of a scene that drifts and divergences are divided by. None
 // of them can be near zero while the scene moves (a resting pile's energy can).
 struct Scales {

@@ -124,6 +124,11 @@ struct RunRecord {
   // in a scene that conserves or only loses energy, with no uniform field): E(end) / |E(0)|.
   // Not in results.json; the reason says it, --record-known writes it as energy_crossed_zero.
   std::optional<double> unbound_ratio;
+  // A bound Newtonian system whose settled energy (the median of one of the run's quarters)
+  // moved from E(0) by more than a quarter of its binding energy (conservation.hpp,
+  // binding_energy): the largest |E_settled - E(0)| / E_b of the four. Not in results.json; the reason says it,
+  // --record-known writes it as binding_energy_change.
+  std::optional<double> binding_change;
   double wall_seconds = 0.0;           // time inside step() only
   double load_seconds = 0.0;
   // Harness accounting (`physval run --overhead FILE`; not in results.json):

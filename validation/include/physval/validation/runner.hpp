@@ -3,7 +3,9 @@
 #pragma once
 
 #include <chrono>
+#include <cmath>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -35,6 +37,22 @@ Scene effective_scene(const Scene& scene, const RunOptions& options);
 // How many steps between samples for this scene (from sample_interval, or automatic:
 // about 400 samples, fewer for scenes with many bodies).
 long sample_every(const Scene& scene, std::size_t max_sample_states);
+
+// Whether an engine's clock `t` after its step k agrees with `stepped`, the sum of the k
+// step lengths it was given (dt each, the last one maybe shorter), checked after every
+// step: to 1% of a step plus the round-off the two may have gathered. An engine that sums
+// its steps rounds k times, each by at most half an ulp of the sum (eps/2 x |t|), and so
+// does `stepped`; one that computes k x dt rounds once: together within k x eps x |t|.
+// Four times that is allowed (an engine that sums substeps rounds more often). Without
+// it a plugin keeping t = k x dt was an error past about 2.6e7 steps of dt = 1e-3 (the
+// sums then differ by 1% of a step). A clock 0.1% fast (off by 1e-3 |t|) stays an error
+// up to k = 1e12; one a whole step ahead up to k = 1/sqrt(4 eps), about 3.4e7 steps of
+// any dt. The round-off term scales with `stepped` (finite), never with t: an infinite or
+// NaN t is never accepted.
+inline bool clock_matches_steps(double t, double stepped, long k, double dt) {
+  const double roundoff = 4.0 * static_cast<double>(k) * std::numeric_limits<double>::epsilon() * std::abs(stepped);
+  return std::abs(t - stepped) <= 0.01 * dt + roundoff;
+}
 
 // Runs one engine on one scene in this process. Never throws: failures become
 // status error / diverged with a reason.
