@@ -348,18 +348,21 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       const double pad = kGapUlps * kEps * (inf_norm(p) + 2.0 * w.radius[i] + 1.0) + w.radius[i];
       return make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad);
     };
-    // A body at rest on its supports takes part with its faces only: the set does not
-    // spread through a pile at rest (its other contacts meet it pair by pair if it moves).
-    // So does a body sliding on a face with friction. One sliding on a frictionless face
-    // takes part with its bodies too: nothing along the face resists it, so an impulse
-    // on it goes on to what it touches there (a row of balls on a frictionless floor
-    // struck at one end; as a leaf each was met pair by pair at one instant, a cycle that
-    // ended in a hold the bodies could not justify: the frictionless pile of seed 2).
+    // A body resting on bodies, or held by several supports, takes part with its faces
+    // only: the set does not spread through a pile at rest (its other contacts meet it pair
+    // by pair if it moves). A body at rest or sliding on one face takes part with its bodies
+    // too, with friction on the face or without: an impulse on it goes on to what it touches
+    // there (a row of balls on a floor struck at one end). Friction does not stop it: in an
+    // impact the face's friction impulse is at most mu times the face's normal impulse, which
+    // is 0 unless the impulses press the body into the face, and the solve below has the face's
+    // contact with its friction. As a leaf a frictionless one was met pair by pair at one
+    // instant, a cycle that ended in a hold the bodies could not justify (the frictionless pile
+    // of seed 2); one with friction got the sequential law's answer (a row of 2 at a wall struck
+    // at e 0.5) or, struck by a body 1000 times lighter, sent it back at a micro-bounce's
+    // minimum separation (Hunt.CoreMeetsTheStrikerIntoAFrictionRowAtAWall...).
     const auto leaf = [&](std::uint32_t i) {
       if (!w.supported(i) || fixed(w, i, fixed_rest, yielding)) return false;
-      if (w.on_body(i) || w.is_held(i)) return true;
-      const PairMaterial m = w.pair_material(w.material[i], w.statics.segments[w.support[i]].material);
-      return m.friction > 0.0 || m.static_friction > 0.0;
+      return w.on_body(i) || w.is_held(i);
     };
     // The impacting pair first, with one broad-phase query for both (an isolated impact,
     // the common case, pays only this); then breadth-first over the rest of the set.
