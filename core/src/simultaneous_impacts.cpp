@@ -1103,7 +1103,10 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     // the floor, met next at the same instant one after another in body order (the notch
     // moved by 4.2e-6 m with the numbering). The inelastic law's answer is taken instead
     // (there: both at rest, the ball jammed in the notch); failing that the first one stands.
-    if (!friction_ok) {
+    // Not in a set with a micro-bounce target (`raised`): the inelastic law drops it, and in
+    // the 50-circle pile at e 0.5 (seed 4) the same impact then came back at the same
+    // instant, 41,000 times in 60 s, where main takes 1 s for the whole run.
+    if (!friction_ok && !raised) {
       friction_solve(2);
       if (!friction_ok) friction_solve(0);
     } else if (!raised && gains_energy()) {
