@@ -571,6 +571,162 @@ def family_misc():
 
 
 # ---------------------------------------------------------------------------------------
+# Family: junctions (a ball started on, beside or sliding into the junction of two pieces
+# of a slope: collinear, concave, convex; core/tests/corehunt_test.cpp holds the same)
+# ---------------------------------------------------------------------------------------
+
+JUNCTION_MU = ((0.0, 0.0), (0.1, 0.1), (0.3, 0.15), (0.577, 0.2885), (1.0, 0.5), (3.0, 1.5))
+
+
+def down_dir(th):
+    return (math.cos(th), -math.sin(th))
+
+
+def up_normal(th):
+    return (math.sin(th), math.cos(th))
+
+
+def add(p, q, k=1.0):
+    return (p[0] + k * q[0], p[1] + k * q[1])
+
+
+def slope_pieces_toml(pieces, mus, muk):
+    toml, mats = "", ""
+    for j, (a, b) in enumerate(pieces):
+        toml += wall("p%d" % j, a, b, 0.0, muk, mus)
+        mats += ('[[materials]]\na = "ball"\nb = "p%d"\nfriction = %s\nstatic_friction = %s\n\n' % (j, f(muk), f(mus)))
+    return toml + mats
+
+
+def ulp_of(J):
+    m = max(abs(J[0]), abs(J[1]), 1.0)
+    return math.ldexp(1.0, math.frexp(m)[1] - 1 - 52)
+
+
+def family_junctions():
+    cases = []
+    T, r, dt = 1.5, 0.1, 1.0 / 60
+    g = (0.0, -G0)
+    # collinear: on the junction or 1, 4 ulps either side; 2 pieces or 3 (a second
+    # junction 0.5 m down)
+    for deg in (1, 10, 30, 45, 53, 60, 70, 80, 89):
+        th = math.radians(deg)
+        d, n = down_dir(th), up_normal(th)
+        for mus, muk in JUNCTION_MU:
+            if abs(math.tan(th) - mus) < 1e-6:
+                continue
+            for v0 in (1.5, 0.0, -1.5):
+                for J in ((0.0, 0.0), (3.7, -1.3)):
+                    u = ulp_of(J)
+                    for k in (0, 1, -1, 4, -4):
+                        for npieces in (2, 3):
+                            L = 20.0
+                            pieces = [(add(J, d, -L), J)]
+                            if npieces == 2:
+                                pieces.append((J, add(J, d, L)))
+                            else:
+                                pieces += [(J, add(J, d, 0.5)), (add(J, d, 0.5), add(J, d, L))]
+                            p0 = add(add(J, d, k * u), n, r)
+                            sT, vT = slope_closed_form(th, mus, muk, v0, T)
+                            name = "collinear_%d_%s_%s_%s_%d_%d_%d" % (deg, str(mus).replace(".", "p"), str(v0).replace(".", "p").replace("-", "m"),
+                                                                     "o" if J[0] == 0 else "j", k + 4, npieces, len(cases))
+                            toml = header(name, T, dt, g) + body("ball", p0, (v0 * d[0], v0 * d[1]), r, 1.0, 0.0)
+                            toml += slope_pieces_toml(pieces, mus, muk)
+                            cases.append(Case("junctions", name, toml,
+                                              judge_final({"ball": (add(p0, d, sT), (vT * d[0], vT * d[1]))}, None, pos_tol=1e-7)))
+    # concave: thB = thA - dth; in the pocket (touching both) or from 0.3 m up A into it
+    for degA in (10, 30, 45, 60, 80):
+        for ddeg in (5, 20, 40):
+            if degA - ddeg < 3:
+                continue
+            thA, thB, dth = math.radians(degA), math.radians(degA - ddeg), math.radians(ddeg)
+            dA, nA, dB, nB = down_dir(thA), up_normal(thA), down_dir(thB), up_normal(thB)
+            for mus, muk in JUNCTION_MU:
+                if abs(math.tan(thA) - mus) < 1e-6 or abs(math.tan(thB) - mus) < 1e-6:
+                    continue
+                J = (3.7, -1.3)
+                pieces = [(add(J, dA, -20.0), J), (J, add(J, dB, 20.0))]
+                c = r / (1.0 + nA[0] * nB[0] + nA[1] * nB[1])
+                pocket = (J[0] + c * (nA[0] + nB[0]), J[1] + c * (nA[1] + nB[1]))
+                for v0 in (0.0, 1.5):
+                    for k in (0, 1, -1):
+                        p0 = add(pocket, dB, k * ulp_of(J))
+                        sT, vT = slope_closed_form(thB, mus, muk, v0, T)
+                        name = "concave_pocket_%d_%d_%s_%s_%d_%d" % (degA, ddeg, str(mus).replace(".", "p"), str(v0).replace(".", "p"), k + 1, len(cases))
+                        toml = header(name, T, dt, g) + body("ball", p0, (v0 * dB[0], v0 * dB[1]), r, 1.0, 0.0)
+                        toml += slope_pieces_toml(pieces, mus, muk)
+                        cases.append(Case("junctions", name, toml,
+                                          judge_final({"ball": (add(p0, dB, sT), (vT * dB[0], vT * dB[1]))}, None, pos_tol=1e-7)))
+                    aA = G0 * (math.sin(thA) - muk * math.cos(thA))
+                    if v0 == 0.0 and math.tan(thA) <= mus:
+                        continue
+                    D = 0.3
+                    if aA == 0.0:
+                        t1 = D / v0
+                    else:
+                        disc = v0 * v0 + 2 * aA * D
+                        if disc <= 0:
+                            continue
+                        t1 = (-v0 + math.sqrt(disc)) / aA
+                    if not t1 < T - 0.1:
+                        continue
+                    v1 = v0 + aA * t1
+                    vn, vt = v1 * math.sin(dth), v1 * math.cos(dth)
+                    vt2 = 0.0 if vt <= mus * vn else vt - min(muk * vn, vt)
+                    sB, vB = slope_closed_form(thB, mus, muk, vt2, T - t1)
+                    p0 = add(pocket, dA, -D)
+                    name = "concave_into_%d_%d_%s_%s_%d" % (degA, ddeg, str(mus).replace(".", "p"), str(v0).replace(".", "p"), len(cases))
+                    toml = header(name, T, dt, g) + body("ball", p0, (v0 * dA[0], v0 * dA[1]), r, 1.0, 0.0)
+                    toml += slope_pieces_toml(pieces, mus, muk)
+                    cases.append(Case("junctions", name, toml,
+                                      judge_final({"ball": (add(pocket, dB, sB), (vB * dB[0], vB * dB[1]))}, None, pos_tol=1e-7)))
+    # convex: thB = thA + dth, fast enough to lift off at the junction (v^2 > 1.2 g r cos thA);
+    # judged halfway through its flight (the run ends there)
+    for degA in (0, 10, 30, 45, 60):
+        for ddeg in (5, 20, 40):
+            thA, thB = math.radians(degA), math.radians(degA + ddeg)
+            dA, nA, dB, nB = down_dir(thA), up_normal(thA), down_dir(thB), up_normal(thB)
+            for mus, muk in JUNCTION_MU:
+                if abs(math.tan(thA) - mus) < 1e-6:
+                    continue
+                J = (3.7, -1.3)
+                pieces = [(add(J, dA, -20.0), J), (J, add(J, dB, 20.0))]
+                for v0 in (1.5, 3.0):
+                    for k in (0, 1, -1, None):   # None: from 0.3 m up A
+                        D = 0.3 if k is None else 0.0
+                        p0 = add(add(J, dA, -D if k is None else k * ulp_of(J)), nA, r)
+                        t1, vJ = 0.0, v0
+                        if D > 0:
+                            s1, _ = slope_closed_form(thA, mus, muk, v0, 10.0)
+                            if s1 < D:
+                                continue
+                            aA = G0 * (math.sin(thA) - muk * math.cos(thA))
+                            t1 = D / v0 if aA == 0 else (-v0 + math.sqrt(v0 * v0 + 2 * aA * D)) / aA
+                            vJ = v0 + aA * t1
+                        if not vJ * vJ > 1.2 * G0 * r * math.cos(thA):
+                            continue
+                        pJ = add(J, nA, r)
+                        vel = (vJ * dA[0], vJ * dA[1])
+                        c0 = (pJ[0] - J[0]) * nB[0] + (pJ[1] - J[1]) * nB[1] - r
+                        c1 = vel[0] * nB[0] + vel[1] * nB[1]
+                        c2 = 0.5 * (g[0] * nB[0] + g[1] * nB[1])
+                        tl = (-c1 - math.sqrt(c1 * c1 - 4 * c2 * c0)) / (2 * c2)
+                        if not tl > 0:
+                            continue
+                        tm = 0.5 * tl
+                        dur = t1 + tm
+                        steps = max(1, math.ceil(dur * 60))
+                        want = (pJ[0] + vel[0] * tm, pJ[1] + vel[1] * tm + 0.5 * g[1] * tm * tm)
+                        vw = (vel[0], vel[1] + g[1] * tm)
+                        name = "convex_%d_%d_%s_%s_%s_%d" % (degA, ddeg, str(mus).replace(".", "p"), str(v0).replace(".", "p"),
+                                                            "up" if k is None else str(k + 1), len(cases))
+                        toml = header(name, dur, dur / steps, g) + body("ball", p0, (v0 * dA[0], v0 * dA[1]), r, 1.0, 0.0)
+                        toml += slope_pieces_toml(pieces, mus, muk)
+                        cases.append(Case("junctions", name, toml, judge_final({"ball": (want, vw)}, None, pos_tol=1e-7)))
+    return cases
+
+
+# ---------------------------------------------------------------------------------------
 # Judges: each returns a list of finding strings for core's run and for the reference
 # ---------------------------------------------------------------------------------------
 
@@ -689,7 +845,7 @@ def judge_trail(pT, vT, rate, T):
     return judge
 
 
-FAMILIES = {"drag": family_drag, "slopes": family_slopes, "billiard": family_billiard,
+FAMILIES = {"drag": family_drag, "slopes": family_slopes, "junctions": family_junctions, "billiard": family_billiard,
             "cradle": family_cradle, "kepler": family_kepler, "misc": family_misc}
 
 

@@ -280,6 +280,9 @@ class EventLoop {
       const toi::SegmentHit hit =
           toi::circle_segment(p, v, a, w_.radius[i], seg.from, seg.to, T_ - t, w_.length_scale, w_.force_acc(i));
       if (hit.s == toi::kNever || (k == own_face && !hit.cap)) continue;
+      // Another piece on the support's line, or a cap at a junction on it, is the same
+      // constraint (resting_contact.cpp).
+      if (own_face != kNone && on_support_line(w_, i, k, hit.cap, p + hit.s * v + (0.5 * hit.s * hit.s) * a)) continue;
       // A face's event carries the side it is met from (in b's unused version bits).
       const std::uint32_t from_back = !hit.cap && dot(hit.normal, seg.normal) < 0.0 ? 1u : 0u;
       push(Event::make(t + hit.s, i, k, w_.version[i], from_back, EventKind::Static, hit.cap ? 1 : 0));
@@ -631,7 +634,8 @@ class EventLoop {
       case EventKind::Leave: {
         const double t = refine_leave(w_, e.a, e.time, w_.tloc[e.a], T_);
         end_substep(w_, e.a, t);
-        release_support(w_, e.a);
+        // At a junction with a collinear piece the support carries on on that piece.
+        if (!hand_over_support(w_, e.a, ctx_.t0 + t, ctx_.dt)) release_support(w_, e.a);
         ++w_.version[e.a];
         reschedule(e.a, t);
         free_dependents(e.a, t);
@@ -905,6 +909,8 @@ class EventLoop {
       // side the wall order gave; at once it stops in the pocket, where the hold takes it).
       finish_simultaneous(t, t_abs);
       return;
+    } else if (slow && face && !own_support && w_.supported(i) && settle_on_next_face(w_, i, k, n, m)) {
+      // A concave corner: from its face onto the next one (resting_contact.cpp).
     } else if (slow && face && (!w_.supported(i) || own_support)) {
       // Settle: the normal velocity goes (friction impulse included), and the body
       // rests on this face until it is lifted, pulled away or slides off its end.

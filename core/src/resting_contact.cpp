@@ -2124,8 +2124,10 @@ double support_leave_time(const World& w, std::uint32_t i, double t, double T) {
   const Vec2 v = w.vel_at(i, t);
   const Vec2 a = w.apath[i];
   // u(s) = u0 + u1 s + u2 s^2 along the segment; it leaves at u = 0 falling or at
-  // u = L rising.
-  const double u0 = dot(p - s.from, s.dir), u1 = dot(v, s.dir), u2 = 0.5 * dot(a, s.dir);
+  // u = L rising. A supported body is on its face's span: u0 outside it is round-off
+  // (a body handed over at a junction is up to an ulp of the coordinates before the next
+  // piece's start), read as the end itself, so that it leaves only if it heads out.
+  const double u0 = std::clamp(dot(p - s.from, s.dir), 0.0, s.length), u1 = dot(v, s.dir), u2 = 0.5 * dot(a, s.dir);
   const toi::Tolerance tol = toi::linear_tolerance(w.length_scale, length(v) + length(a) * (T - t));
   toi::Poly lo;
   lo.c[0] = u0;
@@ -2142,6 +2144,125 @@ double support_leave_time(const World& w, std::uint32_t i, double t, double T) {
   const double a_hi = toi::earliest_entry(hi, T - t, {0.0, tol.slope});
   const double s_leave = std::min(a_lo, a_hi);
   return s_leave == toi::kNever ? toi::kNever : t + s_leave;
+}
+
+namespace {
+
+// A piece other than k continuing k's line beyond k's end `end` (heading `out` away from
+// k) at a junction: one of its ends within the coordinates' round-off of `end`, the rest of
+// it beyond, on the same line. kNone if there is none.
+std::uint32_t continuing_piece(World& w, std::uint32_t i, std::uint32_t k, Vec2 end, Vec2 out) {
+  const Segment& s = w.statics.segments[k];
+  const double scale = std::max(std::fabs(end.x), std::fabs(end.y)) + w.radius[i] + w.length_scale;
+  const double tol = 1024.0 * 2.220446049250313e-16 * scale;
+  thread_local std::vector<std::uint32_t> found;
+  found.clear();
+  w.statics.query(make_aabb(end.x - tol, end.y - tol, end.x + tol, end.y + tol), found);
+  for (std::uint32_t o : found) {
+    if (o == k) continue;
+    const Segment& q = w.statics.segments[o];
+    if (w.any_rules && !w.response(w.group[i], q.group).collide) continue;
+    if (std::fabs(dot(q.normal, s.normal)) < 1.0 - 1e-12) continue;   // not on the same line
+    const bool from_here = length(q.from - end) <= tol, to_here = length(q.to - end) <= tol;
+    if (from_here == to_here) continue;
+    const Vec2 onward = from_here ? q.dir : -q.dir;
+    if (dot(onward, out) > 0.0) return o;
+  }
+  return kNone;
+}
+
+}  // namespace
+
+// A junction: body i, on face k and leaving it over one of its ends at t (advanced
+// there), where another piece starts at the same point (to the coordinates' round-off).
+// The rule depends on how the next piece turns:
+//   - on the same line (collinear): it is the same support; the body is handed to it
+//     without an event (released, it met the next face or the first's end cap at zero
+//     time and micro-bounced off it with friction-free flights, or went back and forth
+//     between the two pieces at t = 0 until the event cap);
+//   - turning away from the body (a convex corner): it leaves the face there and flies,
+//     exactly, if it is fast enough to lift off (v^2 > r |a.n|: its gap to the corner
+//     grows); slower, it would roll over the corner's cap, which core does not model (it
+//     micro-bounces, README: Known limits);
+//   - turning towards it (a concave corner): a circle meets the next face before the
+//     junction (an impact, not a leave), with Newton's law and Coulomb's impulse there.
+// Only the collinear case needs a rule here; the others are released.
+bool hand_over_support(World& w, std::uint32_t i, double t_abs, double dt) {
+  if (!w.supported(i) || w.on_body(i) || w.is_held(i)) return false;
+  const std::uint32_t k = w.support[i];
+  const Segment& s = w.statics.segments[k];
+  const Vec2 p = w.pos[i];
+  const Vec2 n = w.support_n[i];
+  const bool at_to = dot(p - s.from, s.dir) > 0.5 * s.length;
+  const Vec2 end = at_to ? s.to : s.from;
+  const std::uint32_t o = continuing_piece(w, i, k, end, at_to ? s.dir : -s.dir);
+  if (o == kNone) return false;
+  const Segment& q = w.statics.segments[o];
+  w.support[i] = o;
+  w.support_n[i] = dot(q.normal, n) > 0.0 ? q.normal : -q.normal;
+  support_path(w, i);
+  record_contact(w, i, kNone, &q, t_abs, dt);
+  return true;
+}
+
+// Whether a face or cap of segment k, met by body i, is no impact: i is on a face and k
+// lies on that face's line (another piece of a slope or floor drawn in pieces), and either
+// its face (which touches the body only where the support does, along the same normal)
+// or an end cap of it or of the support at a junction, where another piece continues the
+// line (a point inside one straight face). (Supported on the lower piece of a slope, a
+// ball started on the junction met the upper piece's face at its very end at t = 0, was
+// released with 1e-20 m/s, settled on the lower one again, for ever: the event cap; or
+// bounced off the upper one's end cap and slid with friction-free flights, 7.6e-4 m off
+// the closed form, ok; on the upper piece, it met its own end cap at t = 0, again and
+// again.) Caps at a free end (a table's edge) stay impacts.
+bool on_support_line(World& w, std::uint32_t i, std::uint32_t k, bool cap, Vec2 at) {
+  if (!w.supported(i) || w.on_body(i) || w.is_held(i)) return false;
+  const std::uint32_t f = w.support[i];
+  const Segment& s = w.statics.segments[f];
+  const Segment& q = w.statics.segments[k];
+  if (k != f) {
+    if (std::fabs(dot(q.normal, s.normal)) < 1.0 - 1e-12) return false;
+    const double scale = std::max({std::fabs(s.from.x), std::fabs(s.from.y), std::fabs(s.to.x), std::fabs(s.to.y),
+                                   std::fabs(q.from.x), std::fabs(q.from.y), std::fabs(q.to.x), std::fabs(q.to.y)}) +
+                         w.length_scale;
+    const double tol = 1024.0 * 2.220446049250313e-16 * scale;
+    if (!(std::fabs(dot(q.from - s.from, s.normal)) <= tol && std::fabs(dot(q.to - s.from, s.normal)) <= tol)) return false;
+    if (!cap) return true;
+  }
+  // The cap nearest the body's contact point (its centre at `at` at the hit), and whether the line continues past it.
+  const Vec2 c = at - w.radius[i] * w.support_n[i];
+  const bool at_to = length_squared(c - q.to) < length_squared(c - q.from);
+  return continuing_piece(w, i, k, at_to ? q.to : q.from, at_to ? q.dir : -q.dir) != kNone;
+}
+
+// A concave corner: body i, on face f, meets face k (along its normal n, too slowly to
+// bounce clear: pressed, e |vn| below the rest speed) where k turns towards it. Newton's
+// law at k (e = 0 there, as any settling) with Coulomb's impulse; if the body then moves
+// and is pulled along k away from f (or stays at rest on k), it leaves f and rests on k:
+// true. Otherwise (it would press into f too: a V) nothing changes: false. (Released from
+// f and bounced off k at half the rest speed, a ball started at rest in the pocket of two
+// pieces of a slope, or sliding into it, flew free of friction for 4e-5 s and ended up to
+// 2.5e-5 m off the closed form, ok.)
+bool settle_on_next_face(World& w, std::uint32_t i, std::uint32_t k, Vec2 n, const PairMaterial& m) {
+  if (!w.supported(i) || w.on_body(i) || w.is_held(i) || w.support[i] == k) return false;
+  const std::uint32_t f = w.support[i];
+  const Vec2 nf = w.support_n[i];
+  if (dot(nf, n) >= 1.0 - 1e-12) return false;   // the same line: a junction, not a corner
+  const Vec2 v_before = w.vel[i];
+  PairMaterial inelastic = m;
+  inelastic.restitution = 0.0;
+  resolve_static(w, i, n, inelastic, 0.0);
+  w.support[i] = k;
+  w.support_n[i] = n;
+  support_path(w, i);
+  const double tol = 64.0 * 2.220446049250313e-16;
+  const bool leaves = dot(w.vel[i], nf) >= -tol * length(w.vel[i]) && dot(w.apath[i], nf) >= -tol * length(w.acc[i]);
+  if (leaves) return true;
+  w.vel[i] = v_before;
+  w.support[i] = f;
+  w.support_n[i] = nf;
+  support_path(w, i);
+  return false;
 }
 
 }  // namespace physval::core_detail

@@ -460,6 +460,16 @@ void held_on(const World& w, std::uint32_t j, std::vector<std::uint32_t>& out);
 // segment, from time t (toi::kNever if not in [t, T]).
 double support_stop_time(const World& w, std::uint32_t i, double t, double T);
 double support_leave_time(const World& w, std::uint32_t i, double t, double T);
+// Body i, leaving its face k over one of its ends (advanced to that moment), where a
+// collinear piece continues the face: handed over to it (true), else nothing changes.
+bool hand_over_support(World& w, std::uint32_t i, double t_abs, double dt);
+// Whether segment k is another piece on the line of body i's supporting face.
+// Its face, or a cap at a junction of pieces on that line (cap; i's centre at `at` when it
+// meets it), is no impact for i.
+bool on_support_line(World& w, std::uint32_t i, std::uint32_t k, bool cap, Vec2 at);
+// A concave corner: body i, on a face, meets face k slowly along n; if after Newton's
+// law at k (e = 0, Coulomb) it moves along k away from its face, it rests on k (true).
+bool settle_on_next_face(World& w, std::uint32_t i, std::uint32_t k, Vec2 n, const PairMaterial& m);
 
 // Sub-steps (substeps.cpp): an impact inside a step keeps the integrator's order.
 // Whether body i follows sub-steps of its integrator, so that a velocity change inside
