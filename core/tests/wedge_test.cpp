@@ -216,8 +216,9 @@ TEST(CoreWedge, BallOnAWallFallingOntoABallOnTheFloorMeetsNewtonsLawAtAllThreeCo
 // (its only free direction, down along B, runs into the wall). At rest, A's weight needs
 // a horizontal floor force mA g nx / |ny| <= mu (mA + mB) g, weaker. So for
 // mu |ny| >= nx: A at rest touching the wall and B, B where it was, for good. Every
-// numbering at e = 0; at e = 0.3 (A bounces first) the walls' order and the mirror only
-// (the bodies' order: DISABLED_ test below).
+// numbering, wall order and the mirror image to 1e-12, at e = 0 and at e = 0.3 (A bounces
+// first; the bodies' order changed it by up to 4.2e-6 m before a friction set whose law
+// has no solution took the inelastic law's: TheNotchWithFriction... below).
 TEST(CoreWedge, BallDroppedIntoTheNotchOfAWallAndABallWithFrictionStaysThere) {
   int held = 0;
   for (double d : {0.3, 0.5, 0.7}) {
@@ -233,7 +234,7 @@ TEST(CoreWedge, BallDroppedIntoTheNotchOfAWallAndABallWithFrictionStaysThere) {
             // Under Coulomb friction the energy can only fall; allow the micro-bounce bound
             // (README, Several supports) of a few m (v_r / 2)^2 / 2 with v_r = g dt / 16.
             const double vr = g * dt / 16.0;
-            const Trace t = check_all_variants(s, 240, 3.0 * (ratio + 1.0) * 0.125 * vr * vr, 1e-12, where, e == 0.0);
+            const Trace t = check_all_variants(s, 240, 3.0 * (ratio + 1.0) * 0.125 * vr * vr, 1e-12, where);
             if (e > 0.0 || mu * h < d) continue;   // bounces first, or B may slide: no closed form
             ASSERT_FALSE(t.steps.empty());
             const std::vector<BodyState>& end = t.steps.back();
@@ -270,10 +271,15 @@ TEST(CoreWedge, TheFrictionlessNotchDoesNotDependOnTheBodyNumbering) {
   }
 }
 
-// OPEN: with friction at e = 0.3 after a 0.2 m fall, reversing the bodies changes the notch
-// by up to 4.2e-6 m (mA/mB = 10, d = 0.7) and 6.9e-7 m (mA/mB = 0.1); the walls' order and
-// the mirror image do not.
-TEST(CoreWedge, DISABLED_TheNotchWithFrictionDoesNotDependOnTheBodyNumbering) {
+// With friction at e = 0.3 after a 0.2 m fall, reversing the bodies changed the notch by up
+// to 4.2e-6 m (mA/mB = 10, d = 0.7) and 6.9e-7 m (mA/mB = 0.1); the walls' order and the
+// mirror image did not. Cause: at mu 1 and d 0.7 the notch is self-locking (tan 44.4 deg <
+// mu), so Newton's law (A-B parting at 0.3 of its closing speed) has no solution with
+// Coulomb friction at the wall and the floor; Jacobi drifted, and its answer left A moving
+// into the wall and B into the floor, two impacts then met at one instant in body order.
+// Now a friction set whose law has no solution takes the inelastic law's answer
+// (simultaneous_impacts.cpp, friction_ok): A stops in the notch, B stays.
+TEST(CoreWedge, TheNotchWithFrictionDoesNotDependOnTheBodyNumbering) {
   for (double d : {0.5, 0.7}) {
     for (double ratio : {0.1, 10.0}) {
       const std::string where = "e 0.3 mu 1 d " + std::to_string(d) + " mA/mB " + std::to_string(ratio);
@@ -288,7 +294,12 @@ TEST(CoreWedge, DISABLED_TheNotchWithFrictionDoesNotDependOnTheBodyNumbering) {
 // mu |ny| = 0.477 >= nx = 0.3, so the floor's friction can hold B at the impact and after)
 // ends with B 2.2e-7 m off its start and A 6.8e-8 m low: B slipped although Coulomb
 // friction at the floor was never at its limit in the rigid solution. The same scene at
-// mA/mB = 1 and 10, and at mu = 1 and 2, meets the closed form to 1e-9.
+// mA/mB = 1 and 10, and at mu = 1 and 2, meets the closed form to 1e-9. Not the numbering
+// (every variant agrees) nor the self-locking fallback of simultaneous_impacts.cpp (its set
+// has a solution: enumerating the states of A-B, A-wall and B-floor at target 0 gives three,
+// all with A and B at rest): README (Open, the light ball) traces it to the micro-bounce
+// target exact_collisions.cpp gives the 1.98 m/s impact at e = 0 (min_sep 0.5 v_r), which
+// the friction set then pays partly by sliding B.
 TEST(CoreWedge, DISABLED_LightBallInTheNotchWithModerateFrictionLeavesTheOtherWhereItWas) {
   const double d = 0.3, h = std::sqrt(4.0 * r * r - d * d);
   const Trace t = check_all_variants(notch(d, 0.0, 0.1, 1.0, 0.0, 0.5, 0.2), 240, 1e-6, 1e-12, "mu 0.5");
