@@ -661,6 +661,10 @@ int main(int argc, char** argv) {
           std::cerr << "physval: sweep measured nothing: " << nothing << '\n';
           return kExitFailed;
         }
+        if (const std::string wrong = sweep_engines_never_right(result); !wrong.empty()) {
+          std::cerr << "physval: sweep: an engine was right at no step size: " << wrong << '\n';
+          return kExitFailed;
+        }
       }
       return 0;
     }

@@ -264,6 +264,10 @@ int merge_sweep(const MergeOptions& options, std::ostream& out, std::ostream& er
     err << "physval: sweep measured nothing: " << nothing << '\n';
     return 1;
   }
+  if (const std::string wrong = sweep_engines_never_right(result); !wrong.empty()) {
+    err << "physval: sweep: an engine was right at no step size: " << wrong << '\n';
+    return 1;
+  }
   return 0;
 }
 

@@ -338,6 +338,9 @@ SweepResult run_sweep(const Scene& scene, const SweepOptions& options, const Pro
         p.position_error = metric(first, "position_divergence");
         p.energy_error = metric(first, "energy_divergence");
         p.contact_time_error = metric(first, "contact_time_error");
+        for (const Check& check : first.checks) {
+          if (check.enforced && !check.pass) p.checks_failed.push_back(check.what);
+        }
       } catch (const std::exception& e) {
         first.reason = std::string("comparison failed: ") + e.what();
       }

@@ -381,6 +381,10 @@ void print_sweep_table(std::ostream& os, const SweepResult& r) {
     }
     std::string status = run_status_name(p.status);
     if (!p.reason.empty()) status += ": " + p.reason;
+    if (p.status == RunStatus::Ok && !p.checks_failed.empty()) {
+      status += ", missed " + std::to_string(p.checks_failed.size()) + " check" + (p.checks_failed.size() == 1 ? "" : "s") +
+                " (" + p.checks_failed.front() + (p.checks_failed.size() > 1 ? ", ..." : "") + ")";
+    }
     rows.push_back({p.engine, p.setting.empty() ? "-" : display_setting(p.setting), dt_label(p.dt), std::to_string(p.steps),
                     timed ? sci(p.wall_per_sim_median) : "-", spread, sci(p.position_error), sci(p.energy_error),
                     sci(p.contact_time_error), p.pareto ? "*" : "", status});
@@ -477,7 +481,8 @@ nlohmann::json sweep_to_json(const SweepResult& r) {
                       {"position_error", json_number(p.position_error)},
                       {"energy_error", json_number(p.energy_error)},
                       {"contact_time_error", json_number(p.contact_time_error)},
-                      {"pareto", p.pareto}});
+                      {"pareto", p.pareto},
+                      {"checks_failed", p.checks_failed}});
   }
   j["points"] = std::move(points);
   nlohmann::json orders = nlohmann::json::array();
@@ -516,6 +521,26 @@ std::string sweep_measured_nothing(const SweepResult& result) {
   }
   return "every point diverged or failed (" + std::to_string(diverged) + " diverged, " + std::to_string(failed) +
          " failed): no speed or error was measured";
+}
+
+std::string sweep_engines_never_right(const SweepResult& result) {
+  std::vector<std::string> order;
+  std::map<std::string, std::pair<std::size_t, bool>> seen;   // points, one was right
+  for (const SweepPoint& p : result.points) {
+    const std::string& who = p.engine;   // any of its settings may be the right one
+    auto [it, fresh] = seen.try_emplace(who, std::pair<std::size_t, bool>{0, false});
+    if (fresh) order.push_back(who);
+    ++it->second.first;
+    if (usable(p) && p.checks_failed.empty()) it->second.second = true;
+  }
+  std::string out;
+  for (const std::string& who : order) {
+    const auto& [points, right] = seen.at(who);
+    if (right) continue;
+    out += (out.empty() ? "" : "; ") + who + ": none of its " + std::to_string(points) +
+           " points (step sizes x settings) ran whole and held the scenario's checks";
+  }
+  return out;
 }
 
 }  // namespace physval

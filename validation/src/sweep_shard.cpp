@@ -67,6 +67,7 @@ SweepResult sweep_from_shards(const std::vector<nlohmann::json>& shards) {
       p.position_error = number(j, "position_error");
       p.energy_error = number(j, "energy_error");
       p.contact_time_error = number(j, "contact_time_error");
+      if (j.contains("checks_failed")) p.checks_failed = j.at("checks_failed").get<std::vector<std::string>>();
       for (const nlohmann::json& kv : mine[k].at("engine_settings")) {
         p.engine_settings.push_back({kv.at(0).get<std::string>(), kv.at(1).get<std::string>()});
       }

@@ -240,6 +240,39 @@ TEST_F(InfraHunt, ASweepWhosePointsAllDivergedExitsOne) {
                     dir("ok")).status, 0);
 }
 
+// A sweep whose every point missed the scenario's [expect] (hunt6) wrote "ok" and an error
+// figure for each point and exited 0, where `run` of the same scene exits 1. Now each point
+// lists the checks it failed, and an engine right at no step size and no setting makes the
+// sweep (and the merge of its shards) exit 1; one right somewhere is a finding, not a failure.
+TEST_F(InfraHunt, ASweepWhoseEngineMissesTheExpectationAtEveryStepSizeExitsOne) {
+  const std::string fall = "duration = 1.0\ndt = 0.01\n[world]\ngravity = [0.0, -9.81]\n[[bodies]]\nname = \"a\"\n"
+                           "radius = 0.1\nposition = [0.0, 10.0]\n[expect]\nfinal = [ { body = \"a\", velocity = [0.0, ";
+  put(dir_ / "wrong.toml", "name = \"wrong\"\n" + fall + "-9.0], tolerance = 1e-3 } ]\n");   // v = -g t = -9.81
+  put(dir_ / "right.toml", "name = \"right\"\n" + fall + "-9.81], tolerance = 1e-3 } ]\n");
+  const std::string opts = " --engines core,box2d --dt 1/100,1/200 --no-cache -j 1 --quiet --repetitions 1";
+  ASSERT_EQ(physval("run " + dir("wrong.toml") + " --engines core,box2d --no-cache -j 1 --quiet --out " + dir("r")).status, 1);
+  const auto one = physval("sweep " + dir("wrong.toml") + opts + " --out " + dir("sw"));
+  EXPECT_EQ(one.status, 1) << one.output;
+  EXPECT_NE(one.output.find("an engine was right at no step size: core: none of its"), std::string::npos) << one.output;
+  EXPECT_NE(one.output.find("box2d: none of its"), std::string::npos) << one.output;
+  EXPECT_NE(one.output.find("missed 2 checks (expect.final.a.velocity"), std::string::npos) << one.output;
+  const nlohmann::json sweep = nlohmann::json::parse(std::ifstream(dir_ / "sw" / "sweep.json"));
+  for (const auto& p : sweep.at("points")) {
+    EXPECT_EQ(p.at("status"), "ok");
+    EXPECT_EQ(p.at("checks_failed").at(0), "expect.final.a.velocity");
+  }
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(physval("sweep " + dir("wrong.toml") + opts + " --shard " + std::to_string(i) + "/2 --out " + dir("s" + std::to_string(i))).status, 0);
+  }
+  const auto merged = physval("merge " + dir("s0") + " " + dir("s1") + " --out " + dir("m"));
+  EXPECT_EQ(merged.status, 1) << merged.output;
+  EXPECT_NE(merged.output.find("an engine was right at no step size"), std::string::npos) << merged.output;
+  // The right expectation: every point holds it, exit 0, nothing listed.
+  const auto fine = physval("sweep " + dir("right.toml") + opts + " --out " + dir("ok"));
+  EXPECT_EQ(fine.status, 0) << fine.output;
+  EXPECT_EQ(fine.output.find("missed"), std::string::npos) << fine.output;
+}
+
 // --- JUnit: the last run's file ---------------------------------------------------------
 
 // A gate that stopped before writing its JUnit file (bad input, killed by a CI timeout)

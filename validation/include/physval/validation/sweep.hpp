@@ -76,6 +76,9 @@ struct SweepPoint {
   std::optional<double> energy_error;         // energy divergence (relative)
   std::optional<double> contact_time_error;   // s
   bool pareto = false;                // on the speed-against-position-error front
+  // The checks this point's run failed that `run` would fail on (the scenario's [expect],
+  // not a recorded known failure): what each is called ("expect.final.a.velocity").
+  std::vector<std::string> checks_failed;
   std::vector<Setting> engine_settings;   // every setting the engine ran with (its own report)
 };
 
@@ -147,5 +150,14 @@ void write_sweep(const std::filesystem::path& dir, const SweepResult& result);
 // a sweep exits 1 (`physval sweep`, `physval merge` of sweep shards): it printed a table
 // of statuses and exited 0 before, as if the figures had been measured.
 std::string sweep_measured_nothing(const SweepResult& result);
+
+// The engines of which no point (step size and setting) ran whole and held the
+// scenario's expectations: every one diverged, failed, or missed an [expect] that `run`
+// enforces. One setting (explicit Euler) that is never right is a finding of the sweep,
+// not a failure, when another setting of the engine is right somewhere.
+// Empty when each engine has such a point. Such a sweep exits 1 (`physval sweep`,
+// `physval merge` of sweep shards): an engine that misses at every step size exited 0
+// before, its table reading "ok" with an error figure.
+std::string sweep_engines_never_right(const SweepResult& result);
 
 }  // namespace physval
