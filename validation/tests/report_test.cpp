@@ -155,6 +155,25 @@ TEST(Report, DegradesWhenFieldsAreMissing) {
   fs::remove_all(dir);
 }
 
+// A divergence its scenario records as known (the gate passes it) read in the summary
+// exactly like one that fails the gate; the cell now says "(known)", and only there.
+TEST(Report, TheSummaryMarksAKnownDivergence) {
+  const fs::path dir = fresh_dir("known");
+  std::ofstream(dir / "results.json") << R"({"runs": [
+    {"scenario": "orbit", "engine": "core", "status": "ok", "metrics": {}},
+    {"scenario": "orbit", "engine": "chipmunk", "status": "diverged", "known_divergence": true, "metrics": {}},
+    {"scenario": "orbit", "engine": "ode", "status": "diverged", "known_divergence": false, "metrics": {}}
+  ]})";
+  write_report(dir);
+  const std::string page = read_text(dir / "report.html");
+  const std::string known = "<span class=bad>diverged</span> <span class=grey";
+  const std::size_t at = page.find(known);
+  ASSERT_NE(at, std::string::npos) << "no known divergence marked";
+  EXPECT_EQ(page.find(known, at + 1), std::string::npos) << "the unknown divergence is marked known too";
+  EXPECT_NE(page.find("(known)</span>"), std::string::npos);
+  fs::remove_all(dir);
+}
+
 TEST(Report, WithoutGnuplotThePageIsWrittenAndTheErrorRaised) {
   const fs::path dir = fresh_dir("nognuplot");
   SuiteResult suite;
