@@ -914,12 +914,7 @@ class EventLoop {
     } else if (slow && face && (!w_.supported(i) || own_support)) {
       // Settle: the normal velocity goes (friction impulse included), and the body
       // rests on this face until it is lifted, pulled away or slides off its end.
-      PairMaterial inelastic = m;
-      inelastic.restitution = 0.0;
-      resolve_static(w_, i, n, inelastic, 0.0);
-      w_.support[i] = k;
-      w_.support_n[i] = n;
-      support_path(w_, i);
+      settle_on_face(w_, i, k, n, m);
     } else if (!slow && face && !own_support && !w_.any_rules &&
                resolve_simultaneous(w_, i, kSimultaneousFace | k, t, set_, impacted_)) {
       // Body i touches other bodies or faces at this instant: Newton's law at all of

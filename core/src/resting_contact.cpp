@@ -2243,18 +2243,22 @@ bool on_support_line(World& w, std::uint32_t i, std::uint32_t k, bool cap, Vec2 
 // f and bounced off k at half the rest speed, a ball started at rest in the pocket of two
 // pieces of a slope, or sliding into it, flew free of friction for 4e-5 s and ended up to
 // 2.5e-5 m off the closed form, ok.)
-bool settle_on_next_face(World& w, std::uint32_t i, std::uint32_t k, Vec2 n, const PairMaterial& m) {
-  if (!w.supported(i) || w.on_body(i) || w.is_held(i) || w.support[i] == k) return false;
-  const std::uint32_t f = w.support[i];
-  const Vec2 nf = w.support_n[i];
-  if (dot(nf, n) >= 1.0 - 1e-12) return false;   // the same line: a junction, not a corner
-  const Vec2 v_before = w.vel[i];
+void settle_on_face(World& w, std::uint32_t i, std::uint32_t k, Vec2 n, const PairMaterial& m) {
   PairMaterial inelastic = m;
   inelastic.restitution = 0.0;
   resolve_static(w, i, n, inelastic, 0.0);
   w.support[i] = k;
   w.support_n[i] = n;
   support_path(w, i);
+}
+
+bool settle_on_next_face(World& w, std::uint32_t i, std::uint32_t k, Vec2 n, const PairMaterial& m) {
+  if (!w.supported(i) || w.on_body(i) || w.is_held(i) || w.support[i] == k) return false;
+  const std::uint32_t f = w.support[i];
+  const Vec2 nf = w.support_n[i];
+  if (dot(nf, n) >= 1.0 - 1e-12) return false;   // the same line: a junction, not a corner
+  const Vec2 v_before = w.vel[i];
+  settle_on_face(w, i, k, n, m);
   const double tol = 64.0 * 2.220446049250313e-16;
   const bool leaves = dot(w.vel[i], nf) >= -tol * length(w.vel[i]) && dot(w.apath[i], nf) >= -tol * length(w.acc[i]);
   if (leaves) return true;

@@ -470,6 +470,9 @@ bool on_support_line(World& w, std::uint32_t i, std::uint32_t k, bool cap, Vec2 
 // A concave corner: body i, on a face, meets face k slowly along n; if after Newton's
 // law at k (e = 0, Coulomb) it moves along k away from its face, it rests on k (true).
 bool settle_on_next_face(World& w, std::uint32_t i, std::uint32_t k, Vec2 n, const PairMaterial& m);
+// Settles body i on face k (normal n) at once: the normal velocity goes (friction impulse
+// included, Newton e = 0) and the body rests on the face, its path along it.
+void settle_on_face(World& w, std::uint32_t i, std::uint32_t k, Vec2 n, const PairMaterial& m);
 
 // Sub-steps (substeps.cpp): an impact inside a step keeps the integrator's order.
 // Whether body i follows sub-steps of its integrator, so that a velocity change inside
