@@ -143,24 +143,37 @@ struct PairTable {
       return names.emplace(std::string_view(n), static_cast<std::uint32_t>(names.size())).first;
     };
     std::vector<std::uint32_t> out(contacts.size());
+    // A list that does not go back and forth (a gas: thousands of pairs) stops looking at
+    // the last few after its first kTrial contacts if fewer than half of them were there.
+    constexpr std::size_t kTrial = 256;
+    bool use_recent = true;
+    std::size_t hits = 0;
     for (std::size_t k = 0; k < contacts.size(); ++k) {
-      const std::string_view a = contacts[k].a, b = contacts[k].b;
-      bool hit = false;
-      for (std::size_t c = 0; c < recent_count; ++c) {
-        if (recent[c].a == a && recent[c].b == b) {
-          out[k] = recent[c].id;
-          hit = true;
-          break;
+      if (k == kTrial && 2 * hits < kTrial) use_recent = false;
+      if (use_recent) {
+        const std::string_view a = contacts[k].a, b = contacts[k].b;
+        bool hit = false;
+        for (std::size_t c = 0; c < recent_count; ++c) {
+          if (recent[c].a == a && recent[c].b == b) {
+            out[k] = recent[c].id;
+            hit = true;
+            break;
+          }
+        }
+        if (hit) {
+          ++hits;
+          continue;
         }
       }
-      if (hit) continue;
       const auto xa = name(contacts[k].a), yb = name(contacts[k].b);
       const std::uint32_t x = xa->second, y = yb->second;
       const std::uint64_t key = (static_cast<std::uint64_t>(std::min(x, y)) << 32) | std::max(x, y);
       out[k] = pairs.emplace(key, static_cast<std::uint32_t>(pairs.size())).first->second;
-      recent[recent_next] = {xa->first, yb->first, out[k]};
-      recent_next = (recent_next + 1) % kRecent;
-      recent_count = std::max(recent_count, recent_next == 0 ? kRecent : recent_next);
+      if (use_recent) {
+        recent[recent_next] = {xa->first, yb->first, out[k]};
+        recent_next = (recent_next + 1) % kRecent;
+        recent_count = std::max(recent_count, recent_next == 0 ? kRecent : recent_next);
+      }
     }
     return out;
   }
