@@ -143,5 +143,30 @@ TEST_F(Hunt7, ParticlesThroughTheWallsOfAClosedBoxAreEscapes) {
   EXPECT_EQ(seen, 2);
 }
 
+// `physval run --dt` and the loader refuse a step count beyond the most a run takes
+// (Scene::kMaxSteps, 1e9); `physval sweep --dt` did not: Scene::steps() saturates there,
+// so a sweep point at 9e8 s / 1 ms would have stepped a billion times and then covered the
+// remaining 8.99e8 s in one last step. Now bad input (exit 2) naming the file and the step.
+TEST_F(Hunt7, ASweepPointWithMoreStepsThanARunTakesIsBadInput) {
+  const fs::path scene = write("long.toml", R"(name = "long_free"
+duration = 900000000.0
+dt = 1.0
+[[bodies]]
+name = "a"
+shape = "point"
+position = [0.0, 0.0]
+velocity = [1.0, 0.0]
+)");
+  Result ok = physval("check " + scene.string());
+  ASSERT_EQ(ok.status, 0) << ok.output;   // 9e8 steps at its own dt: within the limit
+  for (const std::string& extra : {std::string("--dt 1,1e-3"), std::string("--dt 1 --duration 2e9")}) {
+    Result r = physval("sweep " + scene.string() + " --engines core --quiet --no-cache " + extra + " --out " +
+                       (dir_ / "sweep").string());
+    EXPECT_EQ(r.status, 2) << extra << ": " << r.output;
+    EXPECT_NE(r.output.find("long.toml: at --dt"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("more than physval runs"), std::string::npos) << r.output;
+  }
+}
+
 }  // namespace
 }  // namespace physval
