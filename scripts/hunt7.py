@@ -24,6 +24,8 @@ Families:
              a light ball resting on a heavy one on a floor: the closed form (they part at once
              with Newton's velocities); core must meet it, and no engine may be `ok` with its
              position_divergence below its own miss of the closed form.
+  materials  head-on pairs whose bodies have unequal restitution (the pair's is the smaller):
+             the closed form, judged as massratio.
 
 Exit 1 when any finding (a wrong green, or core/the reference off its closed form), 0 when
 none, 2 on a usage error.
@@ -257,6 +259,41 @@ restitution = {fmt(e)}
                                final={"a": (-0.5 + v1 * T, 0.0), "b": (0.5 + v2 * T, 0.0)}, scale=abs(u1 - u2) * T)
 
 
+def gen_materials(out, truth, quick):
+    """Per-pair restitution (the smaller of the two): head-on pairs with unequal e, apart at t = 0."""
+    for ea, eb in ([(1.0, 0.3)] if quick else [(1.0, 0.3), (0.3, 1.0), (0.9, 0.5), (0.0, 1.0)]):
+        for q in ([1.0] if quick else [1.0, 3.0, 1e3]):
+            e = min(ea, eb)
+            m1, m2, u1, u2 = 1.0, q, 2.0, -1.0
+            v1 = (m1 * u1 + m2 * u2 - m2 * e * (u1 - u2)) / (m1 + m2)
+            v2 = (m1 * u1 + m2 * u2 + m1 * e * (u1 - u2)) / (m1 + m2)
+            tc = 1.0 / (u1 - u2)   # the gap of 1 m closes at 3 m/s
+            T = 1.0
+            name = f"mat_ea{ea}_eb{eb}_q{q:g}".replace(".", "p")
+            text = f"""name = "{name}"
+duration = {fmt(T)}
+dt = "1/240"
+[[bodies]]
+name = "a"
+radius = 0.5
+mass = {fmt(m1)}
+position = [-1.0, 0.0]
+velocity = [{fmt(u1)}, 0.0]
+restitution = {fmt(ea)}
+[[bodies]]
+name = "b"
+radius = 0.5
+mass = {fmt(m2)}
+position = [1.0, 0.0]
+velocity = [{fmt(u2)}, 0.0]
+restitution = {fmt(eb)}
+"""
+            open(os.path.join(out, name + ".toml"), "w").write(text)
+            xa = -1.0 + u1 * tc + v1 * (T - tc)
+            xb = 1.0 + u2 * tc + v2 * (T - tc)
+            truth[name] = dict(family="materials", final={"a": (xa, 0.0), "b": (xb, 0.0)}, scale=abs(u1 - u2) * T)
+
+
 def judge_massratio(name, t, res, out, find):
     for r in res["runs"]:
         if r["status"] == "unsupported":
@@ -272,7 +309,8 @@ def judge_massratio(name, t, res, out, find):
 
 # ---------------------------------------------------------------- driver
 FAMILIES = {"particles": (gen_particles, judge_particles), "graze": (gen_graze, judge_graze),
-            "long": (gen_long, judge_long), "massratio": (gen_massratio, judge_massratio)}
+            "long": (gen_long, judge_long), "massratio": (gen_massratio, judge_massratio),
+            "materials": (gen_materials, judge_massratio)}
 
 
 def main(argv):
