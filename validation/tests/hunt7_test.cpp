@@ -143,6 +143,98 @@ TEST_F(Hunt7, ParticlesThroughTheWallsOfAClosedBoxAreEscapes) {
   EXPECT_EQ(seen, 2);
 }
 
+// Box2D caps a step at 2 m: an 80 m/s ball moves at 60 m/s, x1 = x0 + v1 h. In that step
+// a 0.5 m ball went through a resting one, its chord 0.6-0.74 of the radii's sum off b's
+// centre (0.8-0.52 of the radius deep), and ended 0.08-0.15 m into b on the far side; b
+// never moved. The pass test wanted both ends apart and the displacement to agree with both
+// velocities, so the run was `ok`. Now a step that moved at its end velocity is straight
+// too, and the chord's depth is held beyond the deeper end. A glancing collision inside the
+// step (the path bent: neither velocity gives it) and a pair resolving an overlap (deepest
+// at the start) stay unjudged.
+TEST(Hunt7Containment, APassInBox2DsSpeedClampedStepIsAnEscape) {
+  const double h = 1.0 / 30.0;
+  for (const double off : {0.6, 0.65, 0.7, 0.74}) {
+    Scene s;
+    s.name = "graze";
+    s.dt = h;
+    BodyDef a;
+    a.name = "a";
+    a.radius = 0.5;
+    BodyDef b = a;
+    b.name = "b";
+    s.bodies = {a, b};
+    const Vec2 a0{-1.4, off}, a1{0.6, off};
+    ContainmentMonitor m(s);
+    m.start({at(a0, {80.0, 0.0}), at({0.0, 0.0}, {0.0, 0.0})});
+    m.observe(h, {at(a1, {60.0, 0.0}), at({0.0, 0.0}, {0.0, 0.0})});
+    ASSERT_TRUE(m.record().escaped_bodies.has_value());
+    EXPECT_EQ(*m.record().escaped_bodies, 2) << "off " << off;
+    m.observe(2.0 * h, {at(a1 + Vec2{2.0, 0.0}, {60.0, 0.0}), at({0.0, 0.0}, {0.0, 0.0})});
+    EXPECT_EQ(*m.record().escaped_bodies, 2) << "off " << off;
+
+    // The same ends with a's velocity turned up by a collision inside the step: its
+    // displacement (2, 0) is neither v0 h nor v1 h.
+    ContainmentMonitor bent(s);
+    bent.start({at(a0, {80.0, 0.0}), at({0.0, 0.0}, {0.0, 0.0})});
+    bent.observe(h, {at(a1, {50.0, 20.0}), at({0.0, 0.0}, {10.0, -20.0})});
+    EXPECT_EQ(*bent.record().escaped_bodies, 0) << "off " << off;
+  }
+  // A pair 0.2 m into each other pushed apart along its normal: deepest at the start.
+  Scene s;
+  s.name = "apart";
+  s.dt = h;
+  BodyDef a;
+  a.name = "a";
+  a.radius = 0.5;
+  BodyDef b = a;
+  b.name = "b";
+  s.bodies = {a, b};
+  ContainmentMonitor m(s);
+  m.start({at({-0.4, 0.0}, {0.0, 0.0}), at({0.4, 0.0}, {0.0, 0.0})});
+  m.observe(h, {at({-0.5, 0.05}, {-3.0, 1.5}), at({0.5, 0.0}, {3.0, 0.0})});
+  EXPECT_EQ(*m.record().escaped_bodies, 0);
+}
+
+TEST_F(Hunt7, Box2DThroughABallInItsSpeedClampedStepIsDiverged) {
+  const fs::path scene = write("graze.toml", R"(name = "graze_off65"
+duration = 0.5
+dt = "1/30"
+[[bodies]]
+name = "a"
+radius = 0.5
+position = [-1.4, 0.65]
+velocity = [80.0, 0.0]
+restitution = 1.0
+[[bodies]]
+name = "b"
+radius = 0.5
+position = [0.0, 0.0]
+restitution = 1.0
+)");
+  const fs::path out = dir_ / "out";
+  Result r = physval("run " + scene.string() + " --engines core,box2d --quiet --no-cache --out " + out.string());
+  ASSERT_EQ(r.status, 1) << r.output;
+  std::ifstream in(out / "results.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  int seen = 0;
+  for (const auto& run : j["runs"]) {
+    // The oracle: b never moved, though a's path went 0.35 m into it.
+    if (run["engine"] == "box2d") {
+      for (const auto& f : run["final"]) {
+        if (f["body"] == "b") EXPECT_EQ(f["velocity"][0].get<double>(), 0.0);
+      }
+      EXPECT_EQ(run["status"], "diverged") << run["reason"];
+      EXPECT_EQ(run["metrics"]["escaped_bodies"], 2);
+      ++seen;
+    } else {
+      EXPECT_EQ(run["status"], "ok") << run["reason"];   // core meets b
+      EXPECT_EQ(run["metrics"]["escaped_bodies"], 0);
+      ++seen;
+    }
+  }
+  EXPECT_EQ(seen, 2);
+}
+
 // `physval run --dt` and the loader refuse a step count beyond the most a run takes
 // (Scene::kMaxSteps, 1e9); `physval sweep --dt` did not: Scene::steps() saturates there,
 // so a sweep point at 9e8 s / 1 ms would have stepped a billion times and then covered the
