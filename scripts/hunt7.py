@@ -13,7 +13,7 @@ Families:
   graze      a 0.5 m ball at 80 m/s passing a resting 0.5 m ball within one 1/30 s step,
              0.55-0.95 of the radii's sum off its centre (an overlap on the straight relative
              path of 0.1-0.9 of the radius), equal masses, e = 1: the closed form is the
-             elastic impact. A run whose velocities never changed went through the other ball:
+             elastic impact. A run in which b never moved went through the other ball:
              deeper than half the radius it must not be `ok` (the escape rule); shallower it is
              a missed glancing collision, counted as a note (left by design, README).
   long       a free point over 1e6-1e7 steps with a short last step (duration not a whole
@@ -161,7 +161,8 @@ def judge_graze(name, t, res, out, find):
             continue
         fin = {b["body"]: b for b in r["final"]}
         va, vb = fin["a"]["velocity"], fin["b"]["velocity"]
-        untouched = abs(va[0] - 80.0) < 1e-3 and abs(va[1]) < 1e-3 and math.hypot(*vb) < 1e-3
+        # b never moved: nothing struck it (a may have been slowed by Box2D's speed cap)
+        untouched = abs(va[1]) < 1e-3 and math.hypot(*vb) < 1e-3
         miss = max(math.hypot(va[0] - t["va"][0], va[1] - t["va"][1]), math.hypot(vb[0] - t["vb"][0], vb[1] - t["vb"][1]))
         if r["engine"] == "core" and miss > 1e-6:
             find(name, "core", f"off the elastic impact's closed form by {miss:.3g} m/s ({r['status']})")
