@@ -803,8 +803,10 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
       const std::string then = escaped_first ? "; then " + run.reason : "";
       run.status = RunStatus::Diverged;
       run.diverged_at = c.first_escape_time;
+      // Particles count too (an emitter's points): "of N bodies" would then undercount.
       run.reason = std::to_string(*c.escaped_bodies) + " of " + std::to_string(scene.bodies.size()) +
-                   " bodies passed through a barrier (first " + c.first_escape + " at t = " +
+                   (scene.emitters.empty() ? " bodies" : " bodies and their particles") +
+                   " passed through a barrier (first " + c.first_escape + " at t = " +
                    fmt(c.first_escape_time.value_or(0.0)) + " s)" + then;
       judge_known_divergence(run, scene, "escaped_bodies", *c.escaped_bodies, "");
     }
