@@ -266,10 +266,30 @@ double pair_collapse_speed(World& w, std::uint32_t i, std::uint32_t j, double t)
   thread_local std::vector<Vec2> at;
   cluster.clear();
   at.clear();
+  // On one face (sliding, or at rest there): its face's law says what it does; such a
+  // body presses another only through its own acceleration along the face.
+  const auto on_face = [&](std::uint32_t x) {
+    return w.dynamic(x) && w.inv_mass[x] > 0.0 && w.supported(x) && !w.on_body(x);
+  };
   const auto grounded = [&](std::uint32_t x) {
-    return !w.dynamic(x) || !(w.inv_mass[x] > 0.0) || w.supported(x) || w.stationary(x);
+    return !w.dynamic(x) || !(w.inv_mass[x] > 0.0) || (w.supported(x) && !on_face(x)) || (w.stationary(x) && !on_face(x));
   };
   if (grounded(i) || grounded(j)) return v;
+  // A member's own acceleration at t: a body on a face by its face's law (field before any
+  // train's pushes, kinetic friction against its motion, held by static friction at rest),
+  // a free one by its force.
+  const auto own_acc = [&](std::uint32_t x) {
+    if (!on_face(x)) return w.acc[x];
+    return support_acceleration(w, x, raw_acc(w, x), dot(w.vel_at(x, t), perp(w.support_n[x])));
+  };
+  // What presses the pair of members x and y (n from x to y): how fast they accelerate
+  // into each other (0 when they do not; round-off of equal laws is no pressing).
+  const auto pressing = [&](Vec2 ax, Vec2 ay, Vec2 n) {
+    const double an = dot(ay - ax, n);
+    return an < -1e-12 * (length(ax) + length(ay)) ? -an : 0.0;
+  };
+  bool any_on_face = false;   // some member is on a face: the cluster is judged by pressing
+  double pressed = 0.0;       // the largest pressing between members (or a member and a face)
   const double reach = v * w.step_dt;
   if (w.ground_time != w.time || w.ground_t != t || w.ground_reach.size() != w.size()) {
     if (w.ground_reach.size() != w.size()) {
@@ -303,15 +323,25 @@ double pair_collapse_speed(World& w, std::uint32_t i, std::uint32_t j, double t)
     lo = {std::min(lo.x, w.acc[x].x), std::min(lo.y, w.acc[x].y)};
     hi = {std::max(hi.x, w.acc[x].x), std::max(hi.y, w.acc[x].y)};
     const double pad = r + reach;
-    // A face within reach: the cluster leans on it.
+    const bool x_on_face = on_face(x);
+    any_on_face = any_on_face || x_on_face;
+    const Vec2 ax = own_acc(x);
+    // A face within reach: the cluster leans on it (a free member); a member on a face
+    // leans on a face within reach (its own, a collinear piece, a wall) only if its law
+    // presses it into that face.
     if (!w.statics.segments.empty()) {
       faces.clear();
       w.statics.query(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), faces);
       for (std::uint32_t k : faces) {
         const Segment& s = w.statics.segments[k];
         if (w.any_rules && !w.response(w.group[x], s.group).collide) continue;
+        if (x_on_face && k == w.support[x]) continue;   // its own face: its law holds there
         const double u = std::clamp(dot(p - s.from, s.dir), 0.0, s.length);
-        if (length(p - (s.from + u * s.dir)) - r <= reach) return found_ground();
+        const Vec2 d = p - (s.from + u * s.dir);
+        const double dl = length(d);
+        if (dl - r > reach) continue;
+        if (!x_on_face || !(dl > 0.0)) return found_ground();
+        pressed = std::max(pressed, pressing(Vec2{}, ax, d / dl));
       }
     }
     near.clear();
@@ -329,6 +359,24 @@ double pair_collapse_speed(World& w, std::uint32_t i, std::uint32_t j, double t)
       cluster.push_back(y);
       at.push_back(py);
     }
+  }
+  if (any_on_face) {
+    // Members on faces (collapse3): the cluster is pressed only where two of its members,
+    // or a member and a face, accelerate into each other under their own laws (field,
+    // supports, friction). With no contact force needed anywhere (every such relative
+    // normal acceleration >= 0), nothing presses the pair: two balls on a frictionless
+    // floor, or sliding with the same kinetic friction, or down one slope, meet as without
+    // a field. Else the rest speed of the strongest pressing (never above the pressed one).
+    for (std::size_t q = 0; q < cluster.size(); ++q) {
+      const Vec2 aq = own_acc(cluster[q]);
+      for (std::size_t s2 = q + 1; s2 < cluster.size(); ++s2) {
+        const Vec2 d = at[s2] - at[q];
+        const double dl = length(d);
+        if (!(dl > 0.0) || dl - (w.radius[cluster[q]] + w.radius[cluster[s2]]) > reach) continue;
+        pressed = std::max(pressed, pressing(aq, own_acc(cluster[s2]), d / dl));
+      }
+    }
+    return pressed > 0.0 ? std::min(v, w.rest_speed(pressed, w.step_dt)) : 0.0;
   }
   // Falling freely: only what differs between the members presses them together (never
   // more than the pressed threshold: the rule only ever keeps a restitution).
