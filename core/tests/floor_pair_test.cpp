@@ -203,5 +203,34 @@ TEST(CoreFloorPair, APairPressedAlongASlopeStillCollapses) {
   EXPECT_NEAR(length(fb.position - fa.position), 2.0 * r, 1e-9);
 }
 
+// Newton's cradle on a frictionless floor under gravity, struck slowly (below the old
+// threshold |g| dt / 16): the floor presses nothing along the row, so each law meets its
+// closed form as without a field. Simultaneous (Newton's law at every contact at once):
+// the striker leaves at u (2 - N) / N and every other ball at 2u / N; sequential: the
+// striker stops and the last ball leaves at u.
+TEST(CoreFloorPair, ASlowCradleOnAFrictionlessFloorMeetsBothLawsClosedForms) {
+  const double r = 0.5;
+  for (double u : {2e-3, 1e-4}) {
+    for (int N : {3, 5}) {
+      for (bool sequential : {false, true}) {
+        std::vector<BodyDef> balls = {circle("b0", {-2.0, r}, {u, 0.0}, r)};
+        for (int k = 1; k < N; ++k) balls.push_back(circle("b" + std::to_string(k), {-1.0 + 2.0 * r * (k - 1) + 0.37 * u, r}, {}, r));
+        EngineOptions opts;
+        if (sequential) opts["impact_law"] = std::string("sequential");
+        Sim sim(scene_of(balls, {wall("floor", {-10.0, 0.0}, {10.0, 0.0})}, {0.0, -kG}), opts);
+        sim.run_until(2.0, 1.0 / 60.0);
+        const double n = N;
+        for (int k = 0; k < N; ++k) {
+          const double want = sequential ? (k == N - 1 ? u : 0.0) : (k == 0 ? u * (2.0 - n) / n : 2.0 * u / n);
+          EXPECT_NEAR(sim.state(static_cast<std::size_t>(k)).velocity.x, want, 1e-12 * u)
+              << "u " << u << " N " << N << (sequential ? " sequential" : " simultaneous") << " ball " << k;
+          EXPECT_EQ(sim.state(static_cast<std::size_t>(k)).velocity.y, 0.0);
+        }
+        EXPECT_TRUE(sim.engine.limits_hit().empty());
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace physval::test
