@@ -289,7 +289,6 @@ double pair_collapse_speed(World& w, std::uint32_t i, std::uint32_t j, double t)
     return an < -1e-12 * (length(ax) + length(ay)) ? -an : 0.0;
   };
   bool any_on_face = false;   // some member is on a face: the cluster is judged by pressing
-  double pressed = 0.0;       // the largest pressing between members (or a member and a face)
   const double reach = v * w.step_dt;
   if (w.ground_time != w.time || w.ground_t != t || w.ground_reach.size() != w.size()) {
     if (w.ground_reach.size() != w.size()) {
@@ -303,6 +302,13 @@ double pair_collapse_speed(World& w, std::uint32_t i, std::uint32_t j, double t)
   }
   const auto known = [&](std::uint32_t x) { return w.ground_reach[x] >= 0.0 && w.ground_reach[x] <= reach; };
   if (known(i) || known(j)) return v;
+  // A pair with a body on a face that its own laws press together (a ball landing on one on
+  // the floor, a slider into one held on a slope) is pressed: no cluster to look at.
+  if (on_face(i) || on_face(j)) {
+    const Vec2 d = w.pos_at(j, t) - w.pos_at(i, t);
+    const double dl = length(d);
+    if (!(dl > 0.0) || pressing(own_acc(i), own_acc(j), d / dl) > 0.0) return v;
+  }
   // Every body looked at so far rests, through the others, on what was found.
   const auto found_ground = [&]() {
     for (std::uint32_t x : cluster) {
@@ -340,8 +346,7 @@ double pair_collapse_speed(World& w, std::uint32_t i, std::uint32_t j, double t)
         const Vec2 d = p - (s.from + u * s.dir);
         const double dl = length(d);
         if (dl - r > reach) continue;
-        if (!x_on_face || !(dl > 0.0)) return found_ground();
-        pressed = std::max(pressed, pressing(Vec2{}, ax, d / dl));
+        if (!x_on_face || !(dl > 0.0) || pressing(Vec2{}, ax, d / dl) > 0.0) return found_ground();
       }
     }
     near.clear();
@@ -366,17 +371,17 @@ double pair_collapse_speed(World& w, std::uint32_t i, std::uint32_t j, double t)
     // supports, friction). With no contact force needed anywhere (every such relative
     // normal acceleration >= 0), nothing presses the pair: two balls on a frictionless
     // floor, or sliding with the same kinetic friction, or down one slope, meet as without
-    // a field. Else the rest speed of the strongest pressing (never above the pressed one).
+    // a field. Else the pressed threshold, as before.
     for (std::size_t q = 0; q < cluster.size(); ++q) {
       const Vec2 aq = own_acc(cluster[q]);
       for (std::size_t s2 = q + 1; s2 < cluster.size(); ++s2) {
         const Vec2 d = at[s2] - at[q];
         const double dl = length(d);
         if (!(dl > 0.0) || dl - (w.radius[cluster[q]] + w.radius[cluster[s2]]) > reach) continue;
-        pressed = std::max(pressed, pressing(aq, own_acc(cluster[s2]), d / dl));
+        if (pressing(aq, own_acc(cluster[s2]), d / dl) > 0.0) return found_ground();
       }
     }
-    return pressed > 0.0 ? std::min(v, w.rest_speed(pressed, w.step_dt)) : 0.0;
+    return 0.0;
   }
   // Falling freely: only what differs between the members presses them together (never
   // more than the pressed threshold: the rule only ever keeps a restitution).
