@@ -24,6 +24,8 @@
 // (its impacts with a curved path are not found).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include "world.hpp"
 
@@ -155,9 +157,12 @@ void leave_cap(World& w, std::uint32_t i, const Ride& c, State s, Exit why, doub
   w.pos[i] = c.V + r * n;
   w.vel[i] = (r * s.omega) * cap_tau(c, s.phi);
   w.tloc[i] = te;
+  if (getenv("CAPDBG")) std::fprintf(stderr, "DBG leave cap i %u why %d te %.17g phi %.17g Phi %.17g omega %.17g p %.17g %.17g\n", i, int(why), te, s.phi, c.Phi, s.omega, w.pos[i].x, w.pos[i].y);
+  // Leaving the cap's circle (at third order lifting off, at second order onto a face
+  // tangent to it), the corner is no impact for a moment.
+  const double amag = length(w.acc[i]);
+  w.cap_lifts.push_back({i, c.V, te, amag > 0.0 ? 1e-2 * std::sqrt(r / amag) : 0.0});
   if (why == Exit::LiftOff) {
-    const double amag = length(w.acc[i]);
-    w.cap_lifts.push_back({i, c.V, te, amag > 0.0 ? 1e-2 * std::sqrt(r / amag) : 0.0});
     w.support[i] = kNone;
     w.apath[i] = w.acc[i];   // free for the rest of the step
     return;
@@ -174,10 +179,15 @@ void leave_cap(World& w, std::uint32_t i, const Ride& c, State s, Exit why, doub
 
 }  // namespace
 
-bool lifted_off_cap(const World& w, std::uint32_t i, Vec2 corner, double t) {
+bool corner_of_support(const World& w, std::uint32_t i, Vec2 corner, double t) {
+  const double tol = 1e-9 * (w.radius[i] + w.length_scale);
+  if (w.supported(i) && !w.on_body(i) && !w.is_held(i)) {
+    const Segment& s = w.statics.segments[w.support[i]];
+    if (length(corner - s.from) <= tol || length(corner - s.to) <= tol) return true;
+  }
   for (const World::CapLift& l : w.cap_lifts) {
     if (l.body != i || t < l.t || t > l.t + l.window) continue;
-    if (length(corner - l.V) <= 1e-9 * (w.radius[i] + w.length_scale)) return true;
+    if (length(corner - l.V) <= tol) return true;
   }
   return false;
 }
@@ -254,6 +264,7 @@ double ride_cap(World& w, std::uint32_t i, double t, double T, double t_abs0, do
     c.dA = at_to ? s.dir : -s.dir;
     const Vec2 a = w.varying_forces ? body_acceleration(w, i, w.vel[i]) : w.acc[i];
     const double v_out = dot(w.vel[i], c.dA);
+    if (getenv("CAPDBG")) std::fprintf(stderr, "DBG enter i %u t %.17g v_out %.17g N %.17g\n", i, t, v_out, -v_out * v_out / r - dot(a, c.nA));
     // Fast enough to lift off (its gap to the corner grows): the exact flight.
     if (!(-v_out * v_out / r - dot(a, c.nA) > 0.0)) return -1.0;
     if (w.newtonian || i >= w.scene_bodies || !find_cap(w, i, k, c)) {

@@ -14,6 +14,8 @@
 // step processes at most max_events_per_step events, and at the cap the rest of the
 // step is finished with the lecture pass (reported in limits_hit).
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 
 #include "physval/core/time_of_impact.hpp"
@@ -283,9 +285,11 @@ class EventLoop {
           toi::circle_segment(p, v, a, w_.radius[i], seg.from, seg.to, T_ - t, w_.length_scale, w_.force_acc(i));
       if (hit.s == toi::kNever || (k == own_face && !hit.cap)) continue;
       // The corner a body has just lifted off from its cap (convex_cap.cpp).
-      if (hit.cap && !w_.cap_lifts.empty()) {
+      // An end point of its own face is no impact either: it touches it only at the end,
+      // tangentially, where its leave event rides the corner's cap or lifts off.
+      if (hit.cap && (own_face != kNone || !w_.cap_lifts.empty())) {
         const Vec2 at = p + hit.s * v + (0.5 * hit.s * hit.s) * a;
-        if (lifted_off_cap(w_, i, at - w_.radius[i] * hit.normal, t + hit.s)) continue;
+        if (corner_of_support(w_, i, at - w_.radius[i] * hit.normal, t + hit.s)) continue;
       }
       // Another piece on the support's line, or a cap at a junction on it, is the same
       // constraint (resting_contact.cpp).
@@ -875,6 +879,7 @@ class EventLoop {
       w_.advance(i, t);
     }
     ++w_.stats.impacts;
+    if (getenv("CAPDBG")) std::fprintf(stderr, "DBG static i %u k %u feature %d t %.17g sup %u riding %d p %.17g %.17g v %.17g %.17g\n", i, k, int(feature), t_abs, w_.supported(i) ? w_.support[i] : 999u, int(w_.riding(i)), w_.pos[i].x, w_.pos[i].y, w_.vel[i].x, w_.vel[i].y);
     if (!r.collide) {
       if (r.event) record_contact(w_, i, kNone, &seg, t_abs, ctx_.dt);
       add_passing(w_, static_key(i, k));

@@ -419,9 +419,11 @@ double ride_cap(World& w, std::uint32_t i, double t, double T, double t_abs0, do
 bool settle_on_cap(World& w, std::uint32_t i, double t_abs0, double dt);
 // The box a riding body can reach (its cap's disc, grown by its radius).
 Aabb cap_box(const World& w, std::uint32_t i);
-// Whether body i touching the end point `corner` at time t (in the step) is the corner it
-// has just lifted off (no impact: it leaves the cap's circle at third order, N being 0).
-bool lifted_off_cap(const World& w, std::uint32_t i, Vec2 corner, double t);
+// Whether body i touching the end point `corner` at time t (in the step) is no impact: an
+// end of the face it is on (it touches it only tangentially at the end, where its leave
+// event takes it), or the corner it has just left the cap of (it leaves the cap's circle at
+// third order lifting off, N being 0, at second order onto a face).
+bool corner_of_support(const World& w, std::uint32_t i, Vec2 corner, double t);
 
 // ---- shared pieces
 // Path acceleration of a supported body: the normal component removed and Coulomb
