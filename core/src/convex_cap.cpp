@@ -24,8 +24,6 @@
 // (its impacts with a curved path are not found).
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "world.hpp"
 
@@ -99,9 +97,10 @@ void note_unmodelled(World& w, double t_abs) {
 }
 
 // The next face at corner V of face k (body on side nA, leaving over V along dA): the
-// turn-away piece met first, or the back of k (a free end). False when the cap cannot be
-// modelled: a piece at V turning towards the body, or other geometry within 2r of V.
-bool find_cap(World& w, std::uint32_t i, std::uint32_t k, Ride& c) {
+// turn-away piece met first, or the back of k (a free end): 1. 0: no convex corner (a
+// piece at V continues k's line or turns towards the body: the junction rules'). -1: the
+// cap cannot be modelled: other geometry within 2r of V.
+int find_cap(World& w, std::uint32_t i, std::uint32_t k, Ride& c) {
   const double r = w.radius[i];
   const Vec2 V = c.V;
   const double scale = std::max(std::fabs(V.x), std::fabs(V.y)) + r + w.length_scale;
@@ -121,11 +120,11 @@ bool find_cap(World& w, std::uint32_t i, std::uint32_t k, Ride& c) {
     if (from_here == to_here) {
       // Not at the corner: it must stay out of the cap's reach.
       const double u = std::clamp(dot(V - q.from, q.dir), 0.0, q.length);
-      if (length(q.from + u * q.dir - V) < reach) return false;
+      if (length(q.from + u * q.dir - V) < reach) return -1;
       continue;
     }
     const Vec2 dq = from_here ? q.dir : -q.dir;
-    if (!(dot(dq, c.nA) < 0.0)) return false;   // collinear or turning towards the body
+    if (!(dot(dq, c.nA) < -1e-12)) return 0;   // collinear or turning towards the body
     Vec2 nB = perp(dq);
     if (dot(nB, c.dA) < 0.0) nB = -nB;
     const double Phi = std::atan2(dot(nB, c.dA), dot(nB, c.nA));
@@ -135,7 +134,7 @@ bool find_cap(World& w, std::uint32_t i, std::uint32_t k, Ride& c) {
       c.next = o;
     }
   }
-  return true;
+  return 1;
 }
 
 // No other body's registered box reaches the cap's.
@@ -157,7 +156,6 @@ void leave_cap(World& w, std::uint32_t i, const Ride& c, State s, Exit why, doub
   w.pos[i] = c.V + r * n;
   w.vel[i] = (r * s.omega) * cap_tau(c, s.phi);
   w.tloc[i] = te;
-  if (getenv("CAPDBG")) std::fprintf(stderr, "DBG leave cap i %u why %d te %.17g phi %.17g Phi %.17g omega %.17g p %.17g %.17g\n", i, int(why), te, s.phi, c.Phi, s.omega, w.pos[i].x, w.pos[i].y);
   // Leaving the cap's circle (at third order lifting off, at second order onto a face
   // tangent to it), the corner is no impact for a moment.
   const double amag = length(w.acc[i]);
@@ -216,7 +214,9 @@ bool settle_on_cap(World& w, std::uint32_t i, double t_abs0, double dt) {
       const Vec2 a = w.varying_forces ? body_acceleration(w, i, w.vel[i]) : w.acc[i];
       const double an = dot(a, n), vn = dot(w.vel[i], n);
       if (!(an < 0.0) || std::fabs(vn) > w.rest_speed(an, dt)) continue;
-      if (!find_cap(w, i, k, c)) {
+      const int found = find_cap(w, i, k, c);
+      if (found == 0) continue;
+      if (found < 0) {
         note_unmodelled(w, t_abs0);
         return false;
       }
@@ -264,11 +264,11 @@ double ride_cap(World& w, std::uint32_t i, double t, double T, double t_abs0, do
     c.dA = at_to ? s.dir : -s.dir;
     const Vec2 a = w.varying_forces ? body_acceleration(w, i, w.vel[i]) : w.acc[i];
     const double v_out = dot(w.vel[i], c.dA);
-    if (getenv("CAPDBG")) std::fprintf(stderr, "DBG enter i %u t %.17g v_out %.17g N %.17g\n", i, t, v_out, -v_out * v_out / r - dot(a, c.nA));
     // Fast enough to lift off (its gap to the corner grows): the exact flight.
     if (!(-v_out * v_out / r - dot(a, c.nA) > 0.0)) return -1.0;
-    if (w.newtonian || i >= w.scene_bodies || !find_cap(w, i, k, c)) {
-      note_unmodelled(w, t_abs0 + t);
+    const int found = w.newtonian || i >= w.scene_bodies ? -1 : find_cap(w, i, k, c);
+    if (found <= 0) {
+      if (found < 0) note_unmodelled(w, t_abs0 + t);
       return -1.0;
     }
     c.phi = 0.0;

@@ -14,8 +14,6 @@
 // step processes at most max_events_per_step events, and at the cap the rest of the
 // step is finished with the lecture pass (reported in limits_hit).
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 
 #include "physval/core/time_of_impact.hpp"
@@ -879,7 +877,6 @@ class EventLoop {
       w_.advance(i, t);
     }
     ++w_.stats.impacts;
-    if (getenv("CAPDBG")) std::fprintf(stderr, "DBG static i %u k %u feature %d t %.17g sup %u riding %d p %.17g %.17g v %.17g %.17g\n", i, k, int(feature), t_abs, w_.supported(i) ? w_.support[i] : 999u, int(w_.riding(i)), w_.pos[i].x, w_.pos[i].y, w_.vel[i].x, w_.vel[i].y);
     if (!r.collide) {
       if (r.event) record_contact(w_, i, kNone, &seg, t_abs, ctx_.dt);
       add_passing(w_, static_key(i, k));
