@@ -137,13 +137,19 @@ int find_cap(World& w, std::uint32_t i, std::uint32_t k, Ride& c) {
   return 1;
 }
 
-// No other body's registered box reaches the cap's.
-bool cap_alone(World& w, std::uint32_t i) {
-  thread_local std::vector<std::uint32_t> near;
-  near.clear();
-  w.bp->query_box(cap_box(w, i), i, near);
-  for (std::uint32_t j : near) {
-    if (j != i && w.alive(j)) return false;
+// No other body can reach the cap's disc (radius 2r about the corner) within the step
+// (from its state now, at its speed and acceleration: a scan, paid only on a cap).
+bool cap_alone(const World& w, std::uint32_t i, double dt) {
+  const Vec2 V = w.caps.at(i).V;
+  const double R = 2.0 * w.radius[i] + 1e-9 * (w.radius[i] + w.length_scale);
+  for (std::uint32_t j = 0; j < w.size(); ++j) {
+    if (j == i || !w.alive(j)) continue;
+    if (w.any_rules) {
+      const PairResponse& rr = w.response(w.group[i], w.group[j]);
+      if (!rr.collide && !rr.event) continue;
+    }
+    const double reach = R + w.radius[j] + length(w.vel[j]) * dt + 0.5 * length(w.force_acc(j)) * dt * dt;
+    if (length(w.pos[j] - V) <= reach) return false;
   }
   return true;
 }
@@ -176,6 +182,26 @@ void leave_cap(World& w, std::uint32_t i, const Ride& c, State s, Exit why, doub
 }
 
 }  // namespace
+
+void release_crowded_riders(World& w, double t_abs0, double dt) {
+  if (w.caps.empty()) return;
+  thread_local std::vector<std::uint32_t> out;
+  out.clear();
+  for (const auto& [i, c] : w.caps) {
+    if (!w.dynamic(i) || !cap_alone(w, i, dt)) out.push_back(i);
+  }
+  std::sort(out.begin(), out.end());
+  for (std::uint32_t i : out) {
+    w.caps.erase(i);
+    if (!w.dynamic(i)) continue;
+    w.apath[i] = w.acc[i];
+    note_unmodelled(w, t_abs0);
+  }
+}
+
+void note_cap_disturbed(World& w, std::uint32_t i, double t_abs) {
+  if (w.cap_disturbed == kNone) w.cap_disturbed = i, w.cap_disturbed_time = t_abs;
+}
 
 bool corner_of_support(const World& w, std::uint32_t i, Vec2 corner, double t) {
   const double tol = 1e-9 * (w.radius[i] + w.length_scale);
@@ -228,7 +254,7 @@ bool settle_on_cap(World& w, std::uint32_t i, double t_abs0, double dt) {
       c.phi = phi;
       c.omega = vt / r;
       w.caps[i] = c;
-      if (!cap_alone(w, i)) {
+      if (!cap_alone(w, i, dt)) {
         w.caps.erase(i);
         note_unmodelled(w, t_abs0);
         return false;
@@ -274,15 +300,12 @@ double ride_cap(World& w, std::uint32_t i, double t, double T, double t_abs0, do
     c.phi = 0.0;
     c.omega = v_out / r;
     w.caps[i] = c;
-    if (!cap_alone(w, i)) {
+    if (!cap_alone(w, i, dt)) {
       w.caps.erase(i);
       note_unmodelled(w, t_abs0 + t);
       return -1.0;
     }
     w.support[i] = kNone;   // the cap is the constraint now
-  } else if (!cap_alone(w, i)) {
-    // Another body reaches the cap: its impacts with the curved path are not found.
-    if (w.cap_disturbed == kNone) w.cap_disturbed = i, w.cap_disturbed_time = t_abs0 + t;
   }
   Ride& c = w.caps.at(i);
   w.apath[i] = {};

@@ -218,6 +218,11 @@ class EventLoop {
       if (!r.collide && !r.event) return;
       if (!r.collide && is_passing(w_, pair_key(i, j))) return;
     }
+    // A body riding a corner's cap has no parabola to meet (convex_cap.cpp): said, not met.
+    if (!w_.caps.empty() && (w_.riding(i) || w_.riding(j))) {
+      note_cap_disturbed(w_, w_.riding(i) ? i : j, ctx_.t0 + t);
+      return;
+    }
     const Vec2 pi = w_.pos_at(i, t), pj = w_.pos_at(j, t);
     const Vec2 vi = w_.vel_at(i, t), vj = w_.vel_at(j, t);
     const Vec2 dv = vj - vi;

@@ -1943,11 +1943,11 @@ void push_trains(World& w) {
 void apply_supports(World& w, const StepContext& ctx) {
   w.step_dt = ctx.dt;
   w.cap_lifts.clear();   // lift-offs from a corner's cap (convex_cap.cpp) of the last step
+  release_crowded_riders(w, ctx.t0, ctx.dt);
   w.braced_holds.clear();   // holds of the last step are judged again by hold_pass
   const std::size_t n = w.size();
   for (std::uint32_t i = 0; i < n; ++i) {
     if (w.support[i] == kNone) {
-      if (w.riding(i) && !w.dynamic(i)) w.caps.erase(i);
       if (w.dynamic(i) && !w.riding(i) && !w.statics.segments.empty()) {
         detect_support(w, i, ctx);
         if (w.support[i] != kNone) {

@@ -417,6 +417,12 @@ double ride_cap(World& w, std::uint32_t i, double t, double T, double t_abs0, do
 // (no face holds it), pressed onto it, slower than the rest speed towards it and too slow
 // to lift off: it rides that corner's cap from now (true).
 bool settle_on_cap(World& w, std::uint32_t i, double t_abs0, double dt);
+// At a step's start: riders that another body can reach within the step leave the cap
+// (free, touching the corner: they micro-bounce, counted as unmodelled).
+void release_crowded_riders(World& w, double t_abs0, double dt);
+// Another body's path came within reach of riding body i's cap at t_abs (its impacts are
+// not found): the run's broken guarantee.
+void note_cap_disturbed(World& w, std::uint32_t i, double t_abs);
 // The box a riding body can reach (its cap's disc, grown by its radius).
 Aabb cap_box(const World& w, std::uint32_t i);
 // Whether body i touching the end point `corner` at time t (in the step) is no impact: an

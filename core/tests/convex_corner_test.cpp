@@ -273,5 +273,26 @@ TEST(ConvexCorner, ACapWithAnotherBodyWithinReachIsNamedInTheLimits) {
   EXPECT_NE(sim.engine.limits_hit().back().find("convex corner"), std::string::npos);
 }
 
+// A ball dropped onto a ball riding a table edge's cap (pushed at 1e-6 of the lift-off
+// speed, it rides for about a second): core finds no impacts with a path on a cap, so the
+// run says so (the rider leaves the cap when the other can reach it within a step: limits;
+// or a broken guarantee), never a silent pass-through.
+TEST(ConvexCorner, ABodyComingNearARiderIsNeverSilent) {
+  const double r = 0.1, g = 9.8;
+  for (const double dt : {1.0 / 60.0, 1.0 / 240.0}) {
+    Scene sc = scene_of({circle("ball", {0.0, r}, {1e-6 * std::sqrt(g * r), 0.0}, r, 1.0, 0.0),
+                         circle("drop", {0.02, 2.0}, {}, r, 1.0, 0.0)},
+                        {wall("top", {-2.0, 0.0}, {0.0, 0.0}, 0.0), wall("side", {0.0, 0.0}, {0.0, -2.0}, 0.0)},
+                        {0.0, -g});
+    Sim sim(sc);
+    sim.run_until(1.0, dt);
+    const BodyState a = sim.state("ball"), b = sim.state("drop");
+    const bool said = !sim.engine.limits_hit().empty() || !sim.engine.broken_guarantee().empty();
+    EXPECT_TRUE(said) << "dt " << dt;
+    // and they did not pass through each other
+    EXPECT_GE(length(a.position - b.position), 2.0 * r - 1e-6) << "dt " << dt;
+  }
+}
+
 }  // namespace
 }  // namespace physval::test
