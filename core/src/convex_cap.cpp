@@ -312,7 +312,7 @@ double ride_cap(World& w, std::uint32_t i, double t, double T, double t_abs0, do
   const Friction fr = cap_friction(w, i, w.statics.segments[c.face]);
   const bool friction = fr.moving > 0.0 || fr.holding > 0.0;
   State s{c.phi, c.omega};
-  double tc = t;
+  double tc = std::max(t, w.tloc[i]);   // riding, its state (phi, omega) is at tloc
   for (;;) {
     const Vec2 a = force_on_cap(w, i, r, c, s.phi, s.omega);
     const double an = dot(a, cap_n(c, s.phi)), at = dot(a, cap_tau(c, s.phi));
