@@ -216,7 +216,7 @@ bool corner_of_support(const World& w, std::uint32_t i, Vec2 corner, double t) {
   return false;
 }
 
-bool settle_on_cap(World& w, std::uint32_t i, double t_abs0, double dt) {
+bool settle_on_cap(World& w, std::uint32_t i, double t, double t_abs0, double dt, bool impact) {
   const double r = w.radius[i];
   if (!(r > 0.0) || w.newtonian || i >= w.scene_bodies || w.supported(i) || w.riding(i)) return false;
   const Vec2 p = w.pos[i];
@@ -239,30 +239,39 @@ bool settle_on_cap(World& w, std::uint32_t i, double t_abs0, double dt) {
       c.face = k;
       const Vec2 a = w.varying_forces ? body_acceleration(w, i, w.vel[i]) : w.acc[i];
       const double an = dot(a, n), vn = dot(w.vel[i], n);
-      if (!(an < 0.0) || std::fabs(vn) > w.rest_speed(an, dt)) continue;
+      if (!(an < 0.0) || (!impact && std::fabs(vn) > w.rest_speed(an, dt))) continue;
       const int found = find_cap(w, i, k, c);
       if (found == 0) continue;
       if (found < 0) {
-        note_unmodelled(w, t_abs0);
+        note_unmodelled(w, t_abs0 + t);
         return false;
       }
       const double phi = std::atan2(dot(n, c.dA), dot(n, c.nA));
       if (phi < 0.0 || phi > c.Phi) continue;   // over a face: detect_support's
       const Vec2 tau = -std::sin(phi) * c.nA + std::cos(phi) * c.dA;
+      // Its normal velocity goes, with Coulomb's impulse (as settling on a face).
+      const Vec2 v_before = w.vel[i];
+      PairMaterial inelastic = w.pair_material(w.material[i], s.material);
+      inelastic.restitution = 0.0;
+      if (vn < 0.0) resolve_static(w, i, n, inelastic, 0.0);
       const double vt = dot(w.vel[i], tau);
-      if (!(-vt * vt / r - an > 0.0)) continue;   // lifts off
+      if (!(-vt * vt / r - an > 0.0)) {   // lifts off
+        w.vel[i] = v_before;
+        continue;
+      }
       c.phi = phi;
       c.omega = vt / r;
       w.caps[i] = c;
       if (!cap_alone(w, i, dt)) {
         w.caps.erase(i);
-        note_unmodelled(w, t_abs0);
+        w.vel[i] = v_before;
+        note_unmodelled(w, t_abs0 + t);
         return false;
       }
       w.pos[i] = c.V + r * n;
       w.vel[i] = vt * tau;
       w.apath[i] = {};
-      record_contact(w, i, kNone, &s, t_abs0, dt);
+      record_contact(w, i, kNone, &s, t_abs0 + t, dt);
       return true;
     }
   }

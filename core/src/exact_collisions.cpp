@@ -953,6 +953,18 @@ class EventLoop {
       // its contacts at once (a ball wedged between a wall and another ball).
         finish_simultaneous(t, t_abs);
       return;
+    } else if (slow && !face && !w_.supported(i) && settle_on_cap(w_, i, t, ctx_.t0, ctx_.dt, true)) {
+      // A free body meeting a convex corner too slowly to bounce clear rides its cap
+      // (convex_cap.cpp; it micro-bounced there, first order).
+      ++w_.version[i];
+      const double te = ride_cap(w_, i, t, T_, ctx_.t0, ctx_.dt);
+      if (w_.riding(i)) {
+        w_.bp->grow(i, cap_box(w_, i));
+      } else {
+        reschedule(i, te);
+      }
+      free_dependents(i, t);
+      return;
     } else {
       resolve_static(w_, i, n_resp, m, slow ? 0.5 * vr : 0.0);
       // An interpolated normal must still send the body away from the segment.

@@ -1953,7 +1953,7 @@ void apply_supports(World& w, const StepContext& ctx) {
         if (w.support[i] != kNone) {
           support_path(w, i);
         } else {
-          settle_on_cap(w, i, ctx.t0, ctx.dt);   // at a convex corner (convex_cap.cpp)
+          settle_on_cap(w, i, 0.0, ctx.t0, ctx.dt, false);   // at a convex corner (convex_cap.cpp)
         }
       }
       continue;

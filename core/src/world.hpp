@@ -413,10 +413,12 @@ void record_emission(World& w, std::uint32_t emitter, Vec2 position, Vec2 veloci
 // back onto its own; advanced there, its new support set), or T still riding (its state
 // at T, tloc = T). t_abs0: the step's start time.
 double ride_cap(World& w, std::uint32_t i, double t, double T, double t_abs0, double dt);
-// At a step's start: free body i touching the end point of a segment at a convex corner
-// (no face holds it), pressed onto it, slower than the rest speed towards it and too slow
-// to lift off: it rides that corner's cap from now (true).
-bool settle_on_cap(World& w, std::uint32_t i, double t_abs0, double dt);
+// Free body i (its state at t in the step) touching the end point of a segment at a convex
+// corner (no face holds it), pressed onto it, slower than the rest speed towards it (at a
+// step's start) or meeting it too slowly to bounce clear (impact: e |vn| below the rest
+// speed, as settling on a face) and too slow to lift off: its normal velocity goes
+// (Coulomb's impulse with it) and it rides that corner's cap from t (true).
+bool settle_on_cap(World& w, std::uint32_t i, double t, double t_abs0, double dt, bool impact);
 // At a step's start: riders that another body can reach within the step leave the cap
 // (free, touching the corner: they micro-bounce, counted as unmodelled).
 void release_crowded_riders(World& w, double t_abs0, double dt);

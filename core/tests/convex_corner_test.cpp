@@ -311,6 +311,62 @@ TEST(ConvexCorner, ARideWithDragConvergesAtTheIntegratorsOrder) {
   }
 }
 
+// A ball dropped gently onto a table's edge (slower than the rest speed: 1 mm above it,
+// e = 0), off centre towards the outside: it meets the corner, rides its cap from there
+// (it micro-bounced there, first order) and leaves it where N = 0. Its energy is that of
+// the drop less the normal velocity lost at the landing, so on the cap: u(phi) from the
+// landing point (frictionless), and the flight from the closed-form lift-off point.
+TEST(ConvexCorner, ABallLandingSlowlyOnATableEdgeRidesItsCap) {
+  const double r = 0.1, g = 9.8;
+  int judged = 0;
+  for (const double x0 : {0.002, 0.01, 0.03}) {
+    for (const double dt : {1.0 / 60.0, 1.0 / 240.0}) {
+      const double h = 1e-4;   // the drop: it lands at speed sqrt(2 g h) = 0.044 m/s
+      // centre above the corner at x0 out: lands where |x - V| = r
+      const double y0 = std::sqrt(r * r - x0 * x0) + h;
+      Scene sc = scene_of({circle("ball", {x0, y0}, {}, r, 1.0, 0.0)},
+                          {wall("top", {-2.0, 0.0}, {0.0, 0.0}, 0.0), wall("side", {0.0, 0.0}, {0.0, -2.0}, 0.0)},
+                          {0.0, -g});
+      SCOPED_TRACE("x0 " + std::to_string(x0) + " dt " + std::to_string(dt));
+      // At the landing: centre at (x0, sqrt(r^2 - x0^2)), velocity -sqrt(2 g h) y; the
+      // normal part goes, the tangential part stays (frictionless).
+      const Vec2 V{0.0, 0.0}, nA{0.0, 1.0}, dA{1.0, 0.0};
+      const Vec2 n{x0 / r, std::sqrt(r * r - x0 * x0) / r};
+      const double phi0 = std::atan2(n.x, n.y);
+      const Vec2 tau{n.y, -n.x};
+      const double vt = dot(Vec2{0.0, -std::sqrt(2.0 * g * h)}, tau);
+      // the cap from phi0 on: a cap whose phi = 0 is at phi0
+      const Cap c{V, n, tau, r, 0.0, 0.5 * kPi - phi0, {0.0, -g}};
+      double at = 0.0;
+      ASSERT_EQ(predict(c, vt * vt, at), Outcome::LiftOff);
+      const Vec2 P = V + r * c.n(at), v0 = std::sqrt(c.u(vt * vt, at)) * c.tau(at);
+      (void)nA;
+      (void)dA;
+      Sim sim(sc);
+      std::int64_t impacts = 0;
+      bool done = false;
+      while (sim.engine.time() < 4.0 && !done) {
+        sim.step(dt);
+        impacts += sim.engine.last_step_stats().impacts;
+        const BodyState b = sim.state("ball");
+        if (!(length(b.position - V) > r * (1.0 + 1e-6) && b.position.x > P.x)) continue;
+        const Vec2 e = v0 / length(v0), f = perp(e);
+        const double s = std::sqrt(std::max(2.0 * dot(b.position - P, f) / dot(Vec2{0.0, -g}, f), 0.0));
+        const Vec2 want = P + s * v0 + (0.5 * s * s) * Vec2{0.0, -g};
+        EXPECT_LT(length(b.position - want), 1e-9);
+        EXPECT_LT(length(b.velocity - (v0 + s * Vec2{0.0, -g})), 1e-9);
+        ++judged;
+        done = true;
+      }
+      EXPECT_TRUE(done);
+      EXPECT_EQ(impacts, 1);   // the landing itself, then no micro-bounce
+      EXPECT_TRUE(sim.engine.limits_hit().empty());
+      EXPECT_EQ(sim.engine.broken_guarantee(), "");
+    }
+  }
+  EXPECT_EQ(judged, 6);
+}
+
 // A ball dropped onto a ball riding a table edge's cap (pushed at 1e-6 of the lift-off
 // speed, it rides for about a second): core finds no impacts with a path on a cap, so the
 // run says so (the rider leaves the cap when the other can reach it within a step: limits;
