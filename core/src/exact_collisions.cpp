@@ -710,8 +710,10 @@ class EventLoop {
     const double dl = length(d);
     const Vec2 n = dl > 0.0 ? d / dl : Vec2{1.0, 0.0};
     PairMaterial m = w_.pair_material(w_.material[i], w_.material[j]);
-    // Inelastic collapse: below the collapse speed an impact is perfectly inelastic.
-    if (-dot(w_.vel[j] - w_.vel[i], n) < w_.collapse_speed(i, j)) m.restitution = 0.0;
+    // Inelastic collapse: below the collapse speed an impact is perfectly inelastic (for
+    // a pair whose cluster rests on something; a freely falling one keeps e).
+    const bool slow = collapses(w_, i, j, t, -dot(w_.vel[j] - w_.vel[i], n));
+    if (slow) m.restitution = 0.0;
     double min_sep = 0.0;
     bool settled = false;
     if (w_.any_forces) {
@@ -805,7 +807,6 @@ class EventLoop {
       return;
     }
     if (!settled) {
-      const bool slow = -dot(w_.vel[j] - w_.vel[i], n) < w_.collapse_speed(i, j);
       if (isolated) {
         // resolved above (resolve_pair: neither body is stationary)
       } else if (slow && w_.stationary(j) && !w_.stationary(i)) {

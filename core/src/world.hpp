@@ -363,8 +363,16 @@ struct World {
   }
   // Inelastic collapse: an impact of bodies i and j closing slower than this is
   // perfectly inelastic (restitution falls to 0): the rest speed of the larger of their
-  // accelerations. 0 in a scene without forces.
+  // accelerations. 0 in a scene without forces. This is the speed for a pair whose
+  // cluster rests on something (a face, a static body, a body at rest or on a face);
+  // an impact of two free bodies takes pair_collapse_speed, which asks whether it does.
   double step_dt = 0.0;   // the current step's dt (set by apply_supports)
+  // pair_collapse_speed's memory of one instant (the step's start `time`, t within it):
+  // the bodies found in a cluster that rests on something, with the reach it was found
+  // at (a set's contacts ask about the same bodies again and again at one instant).
+  double ground_time = -1.0, ground_t = -1.0;
+  std::vector<double> ground_reach;
+  std::vector<std::uint32_t> ground_marked;
   double collapse_speed(std::uint32_t i, std::uint32_t j) const {
     if (sim_inelastic) return std::numeric_limits<double>::infinity();
     if (acc.empty() || step_dt == 0.0) return 0.0;
@@ -467,6 +475,26 @@ void rest_on_body(World& w, std::uint32_t i, std::uint32_t j, Vec2 n);
 // Whether body i, pressed onto the stuck body j along n (from j to i), would stay put:
 // pressed, slow, and held by static friction.
 bool can_rest_on(const World& w, std::uint32_t i, std::uint32_t j, Vec2 n, double rest_speed);
+// The inelastic-collapse threshold for an impact of bodies i and j at time t (within the
+// step; resting_contact.cpp). What presses a pair together is its relative acceleration,
+// and, in a cluster that rests on something, the contact forces that hold the cluster up
+// (on average a body in a settling pile does not fall: the pair's relative acceleration
+// is then of the order of the field's). So: when the free bodies touching i or j,
+// transitively, within the collapse speed times dt (the cluster), reach a face, a static
+// body, a body at rest or on a face, or number more than kMaxFreeCluster, it is
+// World::collapse_speed (the larger of the two accelerations); when they reach none (the
+// cluster falls freely), the rest speed of the spread of the members' force accelerations
+// (|(range of a_x, range of a_y)|, at most World::collapse_speed): 0 in a uniform field,
+// which in the cluster's free-falling frame is no force at all, as in a scene without
+// forces.
+inline constexpr std::size_t kMaxFreeCluster = 64;
+double pair_collapse_speed(World& w, std::uint32_t i, std::uint32_t j, double t);
+// Whether an impact of bodies i and j at t closing at `closing` (normal speed, > 0 when
+// they approach) is slower than pair_collapse_speed: its cluster is looked at only when
+// it is slower than World::collapse_speed (never more than that).
+inline bool collapses(World& w, std::uint32_t i, std::uint32_t j, double t, double closing) {
+  return closing < w.collapse_speed(i, j) && closing < pair_collapse_speed(w, i, j, t);
+}
 // Appends the bodies resting on j, and on those in turn, to w.released.
 void collect_dependents(World& w, std::uint32_t j);
 // Several supports at once (resting_contact.cpp). Body i, slow (|v| <= the rest speed
