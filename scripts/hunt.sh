@@ -385,8 +385,8 @@ accel = [{a0}, {a0 - kk * 40.0!r}]
 
 # edge: a ball sliding off a table's end (v^2 >= g r: it flies off at once on the
 # projectile's path; the friction decelerates it up to the end). Slower ones turn about
-# the end point (core micro-bounces there, first order: `edge_slow`, only the reference
-# is judged: converged means within its convergence error of the turn).
+# the end point (core rides the corner's cap since branch corner2: judged against the
+# turn's closed form in core/tests/table_edge_test.cpp and convex_corner_test.cpp).
 for v0 in [2.5, 3.0, 5.0]:
     for mu in [0.0, 0.1, 0.3]:
         for steps in [60, 240]:

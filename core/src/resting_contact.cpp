@@ -1824,7 +1824,7 @@ bool hold_pass(World& w, const StepContext& ctx) {
     return only_in_train(w, i, near, train);
   };
   for (std::uint32_t i = 0; i < n; ++i) {
-    if (!w.dynamic(i)) continue;
+    if (!w.dynamic(i) || w.riding(i)) continue;   // a cap's rider: convex_cap.cpp
     // Free, or at rest on its face and driven along it (the face alone cannot hold it: a
     // second may). A body sliding on its face keeps sliding to its exact stop event.
     const bool driven = w.supported(i) && !w.on_body(i) && w.vel[i] == Vec2{} &&
@@ -2073,13 +2073,19 @@ void push_trains(World& w) {
 
 void apply_supports(World& w, const StepContext& ctx) {
   w.step_dt = ctx.dt;
+  w.cap_lifts.clear();   // lift-offs from a corner's cap (convex_cap.cpp) of the last step
+  release_crowded_riders(w, ctx.t0, ctx.dt);
   w.braced_holds.clear();   // holds of the last step are judged again by hold_pass
   const std::size_t n = w.size();
   for (std::uint32_t i = 0; i < n; ++i) {
     if (w.support[i] == kNone) {
-      if (w.dynamic(i) && !w.statics.segments.empty()) {
+      if (w.dynamic(i) && !w.riding(i) && !w.statics.segments.empty()) {
         detect_support(w, i, ctx);
-        if (w.support[i] != kNone) support_path(w, i);
+        if (w.support[i] != kNone) {
+          support_path(w, i);
+        } else {
+          settle_on_cap(w, i, 0.0, ctx.t0, ctx.dt, false);   // at a convex corner (convex_cap.cpp)
+        }
       }
       continue;
     }

@@ -272,6 +272,35 @@ struct World {
   std::vector<JudgedComponent> justified_components;
   std::int64_t max_events_seen = 0;
 
+  // ---- convex corners (convex_cap.cpp): bodies riding a segment end's cap, the circle of
+  // radius r about the corner their centre moves on (a curved support), by body index.
+  struct CapRide {
+    Vec2 V;          // the corner
+    Vec2 nA, dA;     // the face it came from: normal towards the body, direction out over V
+    Vec2 nB;         // the normal where the cap hands over to the next face (or the back of A)
+    double Phi = 0.0;              // the cap's arc from nA to nB, rotating towards dA
+    std::uint32_t face = 0, next = 0;   // segments: the face it came from, the next face (A's back: face)
+    double phi = 0.0, omega = 0.0;      // its angle on the cap and the angle's rate
+  };
+  std::unordered_map<std::uint32_t, CapRide> caps;
+  // Lift-offs from a cap in this step (body, corner, time in the step, the window after it
+  // in which the corner is no impact: the flight leaves the cap's circle at third order).
+  struct CapLift {
+    std::uint32_t body = 0;
+    Vec2 V;
+    double t = 0.0, window = 0.0;
+  };
+  std::vector<CapLift> cap_lifts;
+  // Bodies too slow to lift off at a convex corner that the cap model could not take
+  // (other geometry or bodies within reach of the cap, Newtonian gravity, particles): they
+  // micro-bounce there, first order (limits_hit names the first).
+  std::int64_t cap_unmodelled = 0;
+  double cap_unmodelled_time = -1.0;
+  // A body came within reach of a body riding a cap (core does not find impacts with a
+  // curved path): a broken guarantee.
+  std::uint32_t cap_disturbed = kNone;
+  double cap_disturbed_time = -1.0;
+
   // ---- helpers
   std::size_t size() const { return pos.size(); }
   bool alive(std::uint32_t i) const { return (flags[i] & kAlive) != 0; }
@@ -280,6 +309,8 @@ struct World {
   bool supported(std::uint32_t i) const { return !support.empty() && support[i] != kNone; }
   bool on_body(std::uint32_t i) const { return supported(i) && (support[i] & kBodySupport) != 0; }
   bool is_held(std::uint32_t i) const { return !support.empty() && support[i] == kHeld; }
+  // On a convex corner's cap (convex_cap.cpp): its path is not a parabola.
+  bool riding(std::uint32_t i) const { return !caps.empty() && caps.count(i) != 0; }
   // Does not move for the rest of the step: static, or at rest on its supports.
   bool stationary(std::uint32_t i) const { return is_static(i) || stuck(i); }
   // At rest on a support: not moving, and held there for the rest of the step.
@@ -380,6 +411,35 @@ void explode_parent(World& w, std::uint32_t emitter, double t_abs);
 // Exact mode: an Emit event for each trail particle due in the step, and its record.
 void schedule_trail_emissions(World& w, const StepContext& ctx, std::vector<Event>& out);
 void record_emission(World& w, std::uint32_t emitter, Vec2 position, Vec2 velocity, double t_abs);
+
+// ---- convex corners (convex_cap.cpp)
+// Body i (on its face, or riding a cap) at time t within the step [0, T]: on its face at a
+// leave event over a convex corner (no collinear piece continues it) and too slow to lift
+// off (N > 0 on the corner's cap), it rides the cap from t; riding, it goes on. Returns -1
+// when it does not ride (it flies: the exact lift-off, or an unmodelled case, counted);
+// else the time <= T its path left the cap (lifted off, handed over onto the next face or
+// back onto its own; advanced there, its new support set), or T still riding (its state
+// at T, tloc = T). t_abs0: the step's start time.
+double ride_cap(World& w, std::uint32_t i, double t, double T, double t_abs0, double dt);
+// Free body i (its state at t in the step) touching the end point of a segment at a convex
+// corner (no face holds it), pressed onto it, slower than the rest speed towards it (at a
+// step's start) or meeting it too slowly to bounce clear (impact: e |vn| below the rest
+// speed, as settling on a face) and too slow to lift off: its normal velocity goes
+// (Coulomb's impulse with it) and it rides that corner's cap from t (true).
+bool settle_on_cap(World& w, std::uint32_t i, double t, double t_abs0, double dt, bool impact);
+// At a step's start: riders that another body can reach within the step leave the cap
+// (free, touching the corner: they micro-bounce, counted as unmodelled).
+void release_crowded_riders(World& w, double t_abs0, double dt);
+// Another body's path came within reach of riding body i's cap at t_abs (its impacts are
+// not found): the run's broken guarantee.
+void note_cap_disturbed(World& w, std::uint32_t i, double t_abs);
+// The box a riding body can reach (its cap's disc, grown by its radius).
+Aabb cap_box(const World& w, std::uint32_t i);
+// Whether body i touching the end point `corner` at time t (in the step) is no impact: an
+// end of the face it is on (it touches it only tangentially at the end, where its leave
+// event takes it), or the corner it has just left the cap of (it leaves the cap's circle at
+// third order lifting off, N being 0, at second order onto a face).
+bool corner_of_support(const World& w, std::uint32_t i, Vec2 corner, double t);
 
 // ---- shared pieces
 // Path acceleration of a supported body: the normal component removed and Coulomb
