@@ -486,7 +486,10 @@ bool can_rest_on(const World& w, std::uint32_t i, std::uint32_t j, Vec2 n, doubl
 // cluster falls freely), the rest speed of the spread of the members' force accelerations
 // (|(range of a_x, range of a_y)|, at most World::collapse_speed): 0 in a uniform field,
 // which in the cluster's free-falling frame is no force at all, as in a scene without
-// forces.
+// forces. A body sliding or at rest on one face is not a support by itself (collapse3):
+// a cluster with such members is pressed (World::collapse_speed) only where two members,
+// or a member and a face other than its own, accelerate into each other under their own
+// laws (field, the face's support and friction); else 0 (two balls along a floor).
 inline constexpr std::size_t kMaxFreeCluster = 64;
 double pair_collapse_speed(World& w, std::uint32_t i, std::uint32_t j, double t);
 // Whether an impact of bodies i and j at t closing at `closing` (normal speed, > 0 when
