@@ -258,6 +258,12 @@ TEST(CoreNumbering, APileGivesTheSameAnswerForEveryNumbering) {
 // cap at about 2 s, whatever the numbering (as before frictionless sliders joined the
 // simultaneous sets): the two lower balls pressed apart up frictionless faces by the
 // heavy one, a collapse core does not yet end.
+// Measured again (branch numbering4, main 2153bdd): no event cap any more; what fails is the
+// mirror image (6.9e-2 m; every unmirrored numbering agrees). The runs agree to the bit (the
+// twins to 7e-15 m) until t = 2.0 s, when the two lower balls, pushed up the faces by the heavy
+// one, reach the faces' far ends (x = +-5.64 m: the contact point passes the end at step 120)
+// and go over the end corners; the mirrored scene meets its corner at the other end of the
+// segment (mirror_x swaps from and to). Not traced further (convex corners).
 TEST(CoreNumbering, DISABLED_TheFrictionlessVWithAHeavyTopBallSettles) {
   check_numberings(v_wedge(20.0, 0.0, 0.0, 10.0), 150, 1e-10, "V e 0 mu 0 slope 20 m3 10", {{0, 1}, {2, 2}});
 }
@@ -287,6 +293,8 @@ TEST(CoreNumbering, DISABLED_TheFrictionlessVWithAHeavyTopBallSettles) {
 // 0 (as friction sets do) fixes it but fails FrictionlessPiles n10_e0_seed1_mu0 and makes
 // n50_e9_seed3_mu0 crawl for minutes. (3) open, slot 0.6: c is a leaf (at rest on bodies: its
 // faces only), so d-c and e-c, due at one instant, are two sets met one after the other.
+// Letting the seed pair's own bodies never be leaves makes every case here at e 0 and 0.3 pass
+// (e 1 still differs), but FrictionlessPiles n50_e9_seed3_mu0 then crawls for minutes.
 TEST(CoreNumbering, DISABLED_ABallDroppedIntoASlotGivesASymmetricAnswerWhateverTheNumbering) {
   for (double e : {0.0, 0.3, 1.0}) {
     for (double mu : {0.0, 0.5}) {
@@ -299,7 +307,8 @@ TEST(CoreNumbering, DISABLED_ABallDroppedIntoASlotGivesASymmetricAnswerWhateverT
   }
 }
 
-// OPEN: the frictionless 8-circle piles at e = 0 depend on the numbering by up to 1.5e-2 m.
+// OPEN: the frictionless 8-circle piles at e = 0 depend on the numbering by up to 1.5e-2 m
+// (measured again on main 2153bdd: 4.1e-2 m seed 1, 0.19 m seed 3; numbering4: 4.1e-2, 0.11 m).
 TEST(CoreNumbering, DISABLED_AFrictionlessInelasticPileGivesTheSameAnswerForEveryNumbering) {
   for (std::uint64_t seed : {1u, 3u}) {
     check_numberings(make_circle_pile(8, 0.0, 0.0, seed), 120, 1e-10, "pile of 8 e 0 mu 0 seed " + std::to_string(seed));
