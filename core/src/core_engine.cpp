@@ -171,6 +171,14 @@ std::string CoreEngine::broken_guarantee() const {
           "for wrong greens)";
     return os.str();
   }
+  if (w.cap_disturbed != core_detail::kNone) {
+    std::ostringstream os;
+    os << "a body came within reach of body '" << w.name(w.cap_disturbed) << "' riding a convex corner's cap at t = "
+       << w.cap_disturbed_time
+       << " s: core does not find impacts with a path on a cap, so bodies may have passed through each other "
+          "(README, Junctions and corners)";
+    return os.str();
+  }
   if (!w.stats.event_cap_hit) return {};
   std::ostringstream os;
   os << "core reached its event cap (" << w.stats.events << " events) in the step ending at t = " << w.time
@@ -186,6 +194,14 @@ std::vector<std::string> CoreEngine::limits_hit() const {
     std::ostringstream os;
     os << "event cap reached in " << w.cap_hits << " step(s), first at t = " << w.first_cap_time
        << " s; the rest of each such step was finished by the lecture pass (max_events_per_step)";
+    out.push_back(os.str());
+  }
+  if (w.cap_unmodelled > 0) {
+    std::ostringstream os;
+    os << "convex corner: " << w.cap_unmodelled << " time(s) a body too slow to lift off at a corner (first at t = "
+       << w.cap_unmodelled_time
+       << " s) had other geometry or bodies within reach of the corner's cap (or Newtonian gravity, or was a "
+          "particle): core has no curved support there, it micro-bounced over the corner (first order)";
     out.push_back(os.str());
   }
   return out;

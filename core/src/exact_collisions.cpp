@@ -22,6 +22,7 @@
 namespace physval::core_detail {
 
 Aabb path_box(const World& w, std::uint32_t i, double t, double T) {
+  if (w.riding(i)) return cap_box(w, i);   // on a convex corner's cap (convex_cap.cpp)
   const double r = w.radius[i];
   const Vec2 p = w.pos_at(i, t);
   if (w.is_static(i)) return make_aabb(p.x - r, p.y - r, p.x + r, p.y + r);
@@ -217,6 +218,11 @@ class EventLoop {
       if (!r.collide && !r.event) return;
       if (!r.collide && is_passing(w_, pair_key(i, j))) return;
     }
+    // A body riding a corner's cap has no parabola to meet (convex_cap.cpp): said, not met.
+    if (!w_.caps.empty() && (w_.riding(i) || w_.riding(j))) {
+      note_cap_disturbed(w_, w_.riding(i) ? i : j, ctx_.t0 + t);
+      return;
+    }
     const Vec2 pi = w_.pos_at(i, t), pj = w_.pos_at(j, t);
     const Vec2 vi = w_.vel_at(i, t), vj = w_.vel_at(j, t);
     const Vec2 dv = vj - vi;
@@ -258,6 +264,7 @@ class EventLoop {
 
   // (The test inline, the rest a call: most bodies of a walled gas meet no face.)
   [[gnu::always_inline]] void schedule_statics(std::uint32_t i, double t, const Aabb& box) {
+    if (w_.riding(i)) return;   // its cap is its constraint (convex_cap.cpp)
     if (may_meet_faces(box)) schedule_faces(i, t, box);
   }
   [[gnu::noinline]] void schedule_faces(std::uint32_t i, double t, const Aabb& box) {
@@ -280,6 +287,13 @@ class EventLoop {
       const toi::SegmentHit hit =
           toi::circle_segment(p, v, a, w_.radius[i], seg.from, seg.to, T_ - t, w_.length_scale, w_.force_acc(i));
       if (hit.s == toi::kNever || (k == own_face && !hit.cap)) continue;
+      // The corner a body has just lifted off from its cap (convex_cap.cpp).
+      // An end point of its own face is no impact either: it touches it only at the end,
+      // tangentially, where its leave event rides the corner's cap or lifts off.
+      if (hit.cap && (own_face != kNone || !w_.cap_lifts.empty())) {
+        const Vec2 at = p + hit.s * v + (0.5 * hit.s * hit.s) * a;
+        if (corner_of_support(w_, i, at - w_.radius[i] * hit.normal, t + hit.s)) continue;
+      }
       // Another piece on the support's line, or a cap at a junction on it, is the same
       // constraint (resting_contact.cpp).
       if (own_face != kNone && on_support_line(w_, i, k, hit.cap, p + hit.s * v + (0.5 * hit.s * hit.s) * a)) continue;
@@ -290,6 +304,10 @@ class EventLoop {
   }
 
   void schedule_body(std::uint32_t i, double t) {
+    if (w_.riding(i)) {   // riding a convex corner's cap: its ride goes on at t (convex_cap.cpp)
+      push(Event::make(t, i, 0, w_.version[i], 0, EventKind::Leave));
+      return;
+    }
     if (w_.supported(i)) {
       const double stop = support_stop_time(w_, i, t, T_);
       if (stop != toi::kNever) push(Event::make(stop, i, 0, w_.version[i], 0, EventKind::Stop));
@@ -632,12 +650,26 @@ class EventLoop {
         break;
       }
       case EventKind::Leave: {
-        const double t = refine_leave(w_, e.a, e.time, w_.tloc[e.a], T_);
-        end_substep(w_, e.a, t);
-        // At a junction with a collinear piece the support carries on on that piece.
-        if (!hand_over_support(w_, e.a, ctx_.t0 + t, ctx_.dt)) release_support(w_, e.a);
+        const bool rode = w_.riding(e.a);
+        double t = rode ? e.time : refine_leave(w_, e.a, e.time, w_.tloc[e.a], T_);
+        if (!rode) end_substep(w_, e.a, t);
+        // At a junction with a collinear piece the support carries on on that piece; at a
+        // convex corner too slow to lift off, the body rides the corner's cap
+        // (convex_cap.cpp) until it leaves it (t: then) or the step ends.
+        if (rode || !hand_over_support(w_, e.a, ctx_.t0 + t, ctx_.dt)) {
+          const double te = ride_cap(w_, e.a, t, T_, ctx_.t0, ctx_.dt);
+          if (te < 0.0) {
+            release_support(w_, e.a);
+          } else {
+            t = te;
+          }
+        }
         ++w_.version[e.a];
-        reschedule(e.a, t);
+        if (w_.riding(e.a)) {
+          w_.bp->grow(e.a, cap_box(w_, e.a));
+        } else {
+          reschedule(e.a, t);
+        }
         free_dependents(e.a, t);
         break;
       }
@@ -678,8 +710,10 @@ class EventLoop {
     const double dl = length(d);
     const Vec2 n = dl > 0.0 ? d / dl : Vec2{1.0, 0.0};
     PairMaterial m = w_.pair_material(w_.material[i], w_.material[j]);
-    // Inelastic collapse: below the collapse speed an impact is perfectly inelastic.
-    if (-dot(w_.vel[j] - w_.vel[i], n) < w_.collapse_speed(i, j)) m.restitution = 0.0;
+    // Inelastic collapse: below the collapse speed an impact is perfectly inelastic (for
+    // a pair whose cluster rests on something; a freely falling one keeps e).
+    const bool slow = collapses(w_, i, j, t, -dot(w_.vel[j] - w_.vel[i], n));
+    if (slow) m.restitution = 0.0;
     double min_sep = 0.0;
     bool settled = false;
     if (w_.any_forces) {
@@ -773,7 +807,6 @@ class EventLoop {
       return;
     }
     if (!settled) {
-      const bool slow = -dot(w_.vel[j] - w_.vel[i], n) < w_.collapse_speed(i, j);
       if (isolated) {
         // resolved above (resolve_pair: neither body is stationary)
       } else if (slow && w_.stationary(j) && !w_.stationary(i)) {
@@ -920,6 +953,18 @@ class EventLoop {
       // Body i touches other bodies or faces at this instant: Newton's law at all of
       // its contacts at once (a ball wedged between a wall and another ball).
         finish_simultaneous(t, t_abs);
+      return;
+    } else if (slow && !face && !w_.supported(i) && settle_on_cap(w_, i, t, ctx_.t0, ctx_.dt, true)) {
+      // A free body meeting a convex corner too slowly to bounce clear rides its cap
+      // (convex_cap.cpp; it micro-bounced there, first order).
+      ++w_.version[i];
+      const double te = ride_cap(w_, i, t, T_, ctx_.t0, ctx_.dt);
+      if (w_.riding(i)) {
+        w_.bp->grow(i, cap_box(w_, i));
+      } else {
+        reschedule(i, te);
+      }
+      free_dependents(i, t);
       return;
     } else {
       resolve_static(w_, i, n_resp, m, slow ? 0.5 * vr : 0.0);

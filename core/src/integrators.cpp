@@ -24,7 +24,8 @@ namespace physval::core_detail {
 
 namespace {
 
-bool free_dynamic(const World& w, std::uint32_t i) { return w.dynamic(i) && !w.supported(i); }
+// (A body riding a convex corner's cap has its own path: convex_cap.cpp.)
+bool free_dynamic(const World& w, std::uint32_t i) { return w.dynamic(i) && !w.supported(i) && !w.riding(i); }
 
 void rk4_paths(World& w, double dt) {
   const std::size_t n = w.size();

@@ -258,6 +258,84 @@ double holding_coefficient(const PairMaterial& m) {
 
 }  // namespace
 
+double pair_collapse_speed(World& w, std::uint32_t i, std::uint32_t j, double t) {
+  const double v = w.collapse_speed(i, j);
+  if (!(v > 0.0) || std::isinf(v)) return v;
+  // Scratch kept between calls (a pile's collapse asks this at most of its impacts).
+  thread_local std::vector<std::uint32_t> cluster, near, faces;
+  thread_local std::vector<Vec2> at;
+  cluster.clear();
+  at.clear();
+  const auto grounded = [&](std::uint32_t x) {
+    return !w.dynamic(x) || !(w.inv_mass[x] > 0.0) || w.supported(x) || w.stationary(x);
+  };
+  if (grounded(i) || grounded(j)) return v;
+  const double reach = v * w.step_dt;
+  if (w.ground_time != w.time || w.ground_t != t || w.ground_reach.size() != w.size()) {
+    if (w.ground_reach.size() != w.size()) {
+      w.ground_reach.assign(w.size(), -1.0);
+    } else {
+      for (std::uint32_t x : w.ground_marked) w.ground_reach[x] = -1.0;
+    }
+    w.ground_marked.clear();
+    w.ground_time = w.time;
+    w.ground_t = t;
+  }
+  const auto known = [&](std::uint32_t x) { return w.ground_reach[x] >= 0.0 && w.ground_reach[x] <= reach; };
+  if (known(i) || known(j)) return v;
+  // Every body looked at so far rests, through the others, on what was found.
+  const auto found_ground = [&]() {
+    for (std::uint32_t x : cluster) {
+      if (w.ground_reach[x] < 0.0) w.ground_marked.push_back(x);
+      if (w.ground_reach[x] < 0.0 || w.ground_reach[x] > reach) w.ground_reach[x] = reach;
+    }
+    return v;
+  };
+  cluster.push_back(i);
+  cluster.push_back(j);
+  at.push_back(w.pos_at(i, t));
+  at.push_back(w.pos_at(j, t));
+  Vec2 lo = w.acc[i], hi = w.acc[i];
+  for (std::size_t q = 0; q < cluster.size(); ++q) {
+    const std::uint32_t x = cluster[q];
+    const Vec2 p = at[q];
+    const double r = w.radius[x];
+    lo = {std::min(lo.x, w.acc[x].x), std::min(lo.y, w.acc[x].y)};
+    hi = {std::max(hi.x, w.acc[x].x), std::max(hi.y, w.acc[x].y)};
+    const double pad = r + reach;
+    // A face within reach: the cluster leans on it.
+    if (!w.statics.segments.empty()) {
+      faces.clear();
+      w.statics.query(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), faces);
+      for (std::uint32_t k : faces) {
+        const Segment& s = w.statics.segments[k];
+        if (w.any_rules && !w.response(w.group[x], s.group).collide) continue;
+        const double u = std::clamp(dot(p - s.from, s.dir), 0.0, s.length);
+        if (length(p - (s.from + u * s.dir)) - r <= reach) return found_ground();
+      }
+    }
+    near.clear();
+    // (a body within reach meets this box, and so does that body's registered box)
+    w.bp->query_box(make_aabb(p.x - pad, p.y - pad, p.x + pad, p.y + pad), x, near);
+    for (std::uint32_t y : near) {
+      if (!w.alive(y) || std::find(cluster.begin(), cluster.end(), y) != cluster.end()) continue;
+      if ((w.flags[x] & kPoint) && (w.flags[y] & kPoint)) continue;
+      if (((w.flags[x] | w.flags[y]) & kParticle) && related_bodies(w, x, y)) continue;
+      if (w.any_rules && !w.response(w.group[x], w.group[y]).collide) continue;
+      const Vec2 py = w.pos_at(y, t);
+      if (length(py - p) - (r + w.radius[y]) > reach) continue;
+      if (grounded(y) || known(y)) return found_ground();
+      if (cluster.size() >= kMaxFreeCluster) return v;
+      cluster.push_back(y);
+      at.push_back(py);
+    }
+  }
+  // Falling freely: only what differs between the members presses them together (never
+  // more than the pressed threshold: the rule only ever keeps a restitution).
+  const double spread = length(hi - lo);
+  return spread > 0.0 ? std::min(v, w.rest_speed(spread, w.step_dt)) : 0.0;
+}
+
 // The contacts that could hold body i now: faces it touches (within 1e-9 of its size
 // and the scene's), and stationary bodies in `near` it touches.
 static void touching_supports(World& w, std::uint32_t i, std::span<const std::uint32_t> near,
@@ -1693,7 +1771,7 @@ bool hold_pass(World& w, const StepContext& ctx) {
     return only_in_train(w, i, near, train);
   };
   for (std::uint32_t i = 0; i < n; ++i) {
-    if (!w.dynamic(i)) continue;
+    if (!w.dynamic(i) || w.riding(i)) continue;   // a cap's rider: convex_cap.cpp
     // Free, or at rest on its face and driven along it (the face alone cannot hold it: a
     // second may). A body sliding on its face keeps sliding to its exact stop event.
     const bool driven = w.supported(i) && !w.on_body(i) && w.vel[i] == Vec2{} &&
@@ -1942,13 +2020,19 @@ void push_trains(World& w) {
 
 void apply_supports(World& w, const StepContext& ctx) {
   w.step_dt = ctx.dt;
+  w.cap_lifts.clear();   // lift-offs from a corner's cap (convex_cap.cpp) of the last step
+  release_crowded_riders(w, ctx.t0, ctx.dt);
   w.braced_holds.clear();   // holds of the last step are judged again by hold_pass
   const std::size_t n = w.size();
   for (std::uint32_t i = 0; i < n; ++i) {
     if (w.support[i] == kNone) {
-      if (w.dynamic(i) && !w.statics.segments.empty()) {
+      if (w.dynamic(i) && !w.riding(i) && !w.statics.segments.empty()) {
         detect_support(w, i, ctx);
-        if (w.support[i] != kNone) support_path(w, i);
+        if (w.support[i] != kNone) {
+          support_path(w, i);
+        } else {
+          settle_on_cap(w, i, 0.0, ctx.t0, ctx.dt, false);   // at a convex corner (convex_cap.cpp)
+        }
       }
       continue;
     }

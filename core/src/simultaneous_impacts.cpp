@@ -249,7 +249,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       const double dl = length(d);
       if (dl > 0.0) closing = std::max(0.0, -dot(vj - vel_now(w, i0, t), d / dl));
     }
-    fixed_rest = closing < w.collapse_speed(i0, face_seed ? i0 : j0);
+    fixed_rest = face_seed ? closing < w.collapse_speed(i0, i0) : collapses(w, i0, j0, t, closing);
   }
   std::uint32_t yielding = kNone;
   if (fixed_rest && !face_seed) {
@@ -289,7 +289,8 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       c.mu_k = mu_k;
       const double wn = dot(vel_now(w, c.b, t) - ((c.a & kSegmentContact) ? Vec2{} : vel_now(w, c.a, t)), c.n);
       const std::uint32_t other = (c.a & kSegmentContact) ? c.b : c.a;
-      const double e = -wn < w.collapse_speed(other, c.b) ? 0.0 : restitution;
+      const bool slow = (c.a & kSegmentContact) ? -wn < w.collapse_speed(other, c.b) : collapses(w, c.a, c.b, t, -wn);
+      const double e = slow ? 0.0 : restitution;
       c.target = std::max(-e * wn, 0.0);
       const bool seed = face_seed ? (c.a == j0 && c.b == i0) : (c.a == std::min(i0, j0) && c.b == std::max(i0, j0));
       if (seed) c.target = std::max(c.target, seed_min_sep);

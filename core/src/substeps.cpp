@@ -153,7 +153,7 @@ double root_near(F&& f, double t0, double lo, double hi, double ftol) {
 }  // namespace
 
 bool uses_substeps(const World& w, std::uint32_t i) {
-  return w.varying_forces && !w.newtonian && w.dynamic(i) && (!w.supported(i) || on_face(w, i)) &&
+  return w.varying_forces && !w.newtonian && w.dynamic(i) && (!w.supported(i) || on_face(w, i)) && !w.riding(i) &&
          (w.integrator == Integrator::VelocityVerlet || w.integrator == Integrator::Rk4);
 }
 

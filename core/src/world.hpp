@@ -272,6 +272,35 @@ struct World {
   std::vector<JudgedComponent> justified_components;
   std::int64_t max_events_seen = 0;
 
+  // ---- convex corners (convex_cap.cpp): bodies riding a segment end's cap, the circle of
+  // radius r about the corner their centre moves on (a curved support), by body index.
+  struct CapRide {
+    Vec2 V;          // the corner
+    Vec2 nA, dA;     // the face it came from: normal towards the body, direction out over V
+    Vec2 nB;         // the normal where the cap hands over to the next face (or the back of A)
+    double Phi = 0.0;              // the cap's arc from nA to nB, rotating towards dA
+    std::uint32_t face = 0, next = 0;   // segments: the face it came from, the next face (A's back: face)
+    double phi = 0.0, omega = 0.0;      // its angle on the cap and the angle's rate
+  };
+  std::unordered_map<std::uint32_t, CapRide> caps;
+  // Lift-offs from a cap in this step (body, corner, time in the step, the window after it
+  // in which the corner is no impact: the flight leaves the cap's circle at third order).
+  struct CapLift {
+    std::uint32_t body = 0;
+    Vec2 V;
+    double t = 0.0, window = 0.0;
+  };
+  std::vector<CapLift> cap_lifts;
+  // Bodies too slow to lift off at a convex corner that the cap model could not take
+  // (other geometry or bodies within reach of the cap, Newtonian gravity, particles): they
+  // micro-bounce there, first order (limits_hit names the first).
+  std::int64_t cap_unmodelled = 0;
+  double cap_unmodelled_time = -1.0;
+  // A body came within reach of a body riding a cap (core does not find impacts with a
+  // curved path): a broken guarantee.
+  std::uint32_t cap_disturbed = kNone;
+  double cap_disturbed_time = -1.0;
+
   // ---- helpers
   std::size_t size() const { return pos.size(); }
   bool alive(std::uint32_t i) const { return (flags[i] & kAlive) != 0; }
@@ -280,6 +309,8 @@ struct World {
   bool supported(std::uint32_t i) const { return !support.empty() && support[i] != kNone; }
   bool on_body(std::uint32_t i) const { return supported(i) && (support[i] & kBodySupport) != 0; }
   bool is_held(std::uint32_t i) const { return !support.empty() && support[i] == kHeld; }
+  // On a convex corner's cap (convex_cap.cpp): its path is not a parabola.
+  bool riding(std::uint32_t i) const { return !caps.empty() && caps.count(i) != 0; }
   // Does not move for the rest of the step: static, or at rest on its supports.
   bool stationary(std::uint32_t i) const { return is_static(i) || stuck(i); }
   // At rest on a support: not moving, and held there for the rest of the step.
@@ -332,8 +363,16 @@ struct World {
   }
   // Inelastic collapse: an impact of bodies i and j closing slower than this is
   // perfectly inelastic (restitution falls to 0): the rest speed of the larger of their
-  // accelerations. 0 in a scene without forces.
+  // accelerations. 0 in a scene without forces. This is the speed for a pair whose
+  // cluster rests on something (a face, a static body, a body at rest or on a face);
+  // an impact of two free bodies takes pair_collapse_speed, which asks whether it does.
   double step_dt = 0.0;   // the current step's dt (set by apply_supports)
+  // pair_collapse_speed's memory of one instant (the step's start `time`, t within it):
+  // the bodies found in a cluster that rests on something, with the reach it was found
+  // at (a set's contacts ask about the same bodies again and again at one instant).
+  double ground_time = -1.0, ground_t = -1.0;
+  std::vector<double> ground_reach;
+  std::vector<std::uint32_t> ground_marked;
   double collapse_speed(std::uint32_t i, std::uint32_t j) const {
     if (sim_inelastic) return std::numeric_limits<double>::infinity();
     if (acc.empty() || step_dt == 0.0) return 0.0;
@@ -373,6 +412,35 @@ void explode_parent(World& w, std::uint32_t emitter, double t_abs);
 void schedule_trail_emissions(World& w, const StepContext& ctx, std::vector<Event>& out);
 void record_emission(World& w, std::uint32_t emitter, Vec2 position, Vec2 velocity, double t_abs);
 
+// ---- convex corners (convex_cap.cpp)
+// Body i (on its face, or riding a cap) at time t within the step [0, T]: on its face at a
+// leave event over a convex corner (no collinear piece continues it) and too slow to lift
+// off (N > 0 on the corner's cap), it rides the cap from t; riding, it goes on. Returns -1
+// when it does not ride (it flies: the exact lift-off, or an unmodelled case, counted);
+// else the time <= T its path left the cap (lifted off, handed over onto the next face or
+// back onto its own; advanced there, its new support set), or T still riding (its state
+// at T, tloc = T). t_abs0: the step's start time.
+double ride_cap(World& w, std::uint32_t i, double t, double T, double t_abs0, double dt);
+// Free body i (its state at t in the step) touching the end point of a segment at a convex
+// corner (no face holds it), pressed onto it, slower than the rest speed towards it (at a
+// step's start) or meeting it too slowly to bounce clear (impact: e |vn| below the rest
+// speed, as settling on a face) and too slow to lift off: its normal velocity goes
+// (Coulomb's impulse with it) and it rides that corner's cap from t (true).
+bool settle_on_cap(World& w, std::uint32_t i, double t, double t_abs0, double dt, bool impact);
+// At a step's start: riders that another body can reach within the step leave the cap
+// (free, touching the corner: they micro-bounce, counted as unmodelled).
+void release_crowded_riders(World& w, double t_abs0, double dt);
+// Another body's path came within reach of riding body i's cap at t_abs (its impacts are
+// not found): the run's broken guarantee.
+void note_cap_disturbed(World& w, std::uint32_t i, double t_abs);
+// The box a riding body can reach (its cap's disc, grown by its radius).
+Aabb cap_box(const World& w, std::uint32_t i);
+// Whether body i touching the end point `corner` at time t (in the step) is no impact: an
+// end of the face it is on (it touches it only tangentially at the end, where its leave
+// event takes it), or the corner it has just left the cap of (it leaves the cap's circle at
+// third order lifting off, N being 0, at second order onto a face).
+bool corner_of_support(const World& w, std::uint32_t i, Vec2 corner, double t);
+
 // ---- shared pieces
 // Path acceleration of a supported body: the normal component removed and Coulomb
 // friction (or rolling resistance) along the support (resting_contact.cpp).
@@ -407,6 +475,26 @@ void rest_on_body(World& w, std::uint32_t i, std::uint32_t j, Vec2 n);
 // Whether body i, pressed onto the stuck body j along n (from j to i), would stay put:
 // pressed, slow, and held by static friction.
 bool can_rest_on(const World& w, std::uint32_t i, std::uint32_t j, Vec2 n, double rest_speed);
+// The inelastic-collapse threshold for an impact of bodies i and j at time t (within the
+// step; resting_contact.cpp). What presses a pair together is its relative acceleration,
+// and, in a cluster that rests on something, the contact forces that hold the cluster up
+// (on average a body in a settling pile does not fall: the pair's relative acceleration
+// is then of the order of the field's). So: when the free bodies touching i or j,
+// transitively, within the collapse speed times dt (the cluster), reach a face, a static
+// body, a body at rest or on a face, or number more than kMaxFreeCluster, it is
+// World::collapse_speed (the larger of the two accelerations); when they reach none (the
+// cluster falls freely), the rest speed of the spread of the members' force accelerations
+// (|(range of a_x, range of a_y)|, at most World::collapse_speed): 0 in a uniform field,
+// which in the cluster's free-falling frame is no force at all, as in a scene without
+// forces.
+inline constexpr std::size_t kMaxFreeCluster = 64;
+double pair_collapse_speed(World& w, std::uint32_t i, std::uint32_t j, double t);
+// Whether an impact of bodies i and j at t closing at `closing` (normal speed, > 0 when
+// they approach) is slower than pair_collapse_speed: its cluster is looked at only when
+// it is slower than World::collapse_speed (never more than that).
+inline bool collapses(World& w, std::uint32_t i, std::uint32_t j, double t, double closing) {
+  return closing < w.collapse_speed(i, j) && closing < pair_collapse_speed(w, i, j, t);
+}
 // Appends the bodies resting on j, and on those in turn, to w.released.
 void collect_dependents(World& w, std::uint32_t j);
 // Several supports at once (resting_contact.cpp). Body i, slow (|v| <= the rest speed

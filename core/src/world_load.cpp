@@ -327,7 +327,8 @@ std::size_t World::memory_bytes() const {
   n += bytes_of(flags) + bytes_of(group) + bytes_of(material) + bytes_of(mass) + bytes_of(angle);
   n += bytes_of(acc) + bytes_of(apath) + bytes_of(vcorr) + bytes_of(tsub) + bytes_of(psub) + bytes_of(vsub) + bytes_of(ksub) + bytes_of(fparams) + bytes_of(support);
   n += bytes_of(dep_head) + bytes_of(dep_next) + bytes_of(released);
-  n += bytes_of(support_n) + last_touch.size() * (sizeof(std::uint64_t) + sizeof(double) + 2 * sizeof(void*)) + bytes_of(name_end);
+  n += bytes_of(support_n) + last_touch.size() * (sizeof(std::uint64_t) + sizeof(double) + 2 * sizeof(void*)) + bytes_of(name_end) +
+       bytes_of(ground_reach) + bytes_of(ground_marked);
   n += name_chars.capacity() + 1;
   n += bytes_of(birth) + bytes_of(lifetime) + bytes_of(parent) + bytes_of(emitters);
   n += statics.memory_bytes() + bytes_of(material_table) + bytes_of(responses) + bytes_of(materials);

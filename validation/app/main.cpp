@@ -622,6 +622,17 @@ int main(int argc, char** argv) {
         if (!d) return bad_input("--duration: expected a positive number of seconds, got \"" + sweep_duration + "\"");
         load.scene->duration = *d;
       }
+      // Every point's run, and the reference at the finest step, within the steps a run
+      // takes: beyond them Scene::steps() saturates, and a run would step a billion times
+      // and then cover the rest of the duration in one last step of that length.
+      for (const double dt : so.dts) {
+        Scene at = *load.scene;
+        at.dt = dt;
+        if (const std::string too_many = scene_steps_error(at); !too_many.empty()) {
+          return bad_input(sweep_scenario + ": at --dt " + dt_label(dt) + (sweep_duration.empty() ? "" : " with --duration") +
+                           ": " + too_many);
+        }
+      }
       const Progress progress = terminal_progress(sweep_quiet);
       SweepResult result = run_sweep(*load.scene, so, progress);
       end_progress(progress);

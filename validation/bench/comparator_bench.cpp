@@ -59,6 +59,29 @@ void BM_ComparePairContactHeavy(benchmark::State& state) {
 }
 BENCHMARK(BM_ComparePairContactHeavy)->Arg(1000)->Arg(10000)->Arg(40000)->Unit(benchmark::kMillisecond);
 
+// pi_billiard_1e8's kind of contact list: two balls and a wall, the contacts alternating
+// between the two pairs (31k per run there), each name a short string.
+void BM_ComparePairTwoPairsAlternating(benchmark::State& state) {
+  const auto contacts = static_cast<std::size_t>(state.range(0));
+  Scene scene;
+  scene.name = "billiard";
+  scene.dt = 1.0 / 240.0;
+  scene.duration = 4.0;
+  RunRecord a = gas_run("a", 2, 0, 100, 1);
+  for (std::size_t k = 0; k < contacts; ++k) {
+    const double t = scene.duration * static_cast<double>(k) / static_cast<double>(contacts);
+    a.contacts.push_back({"light", k % 2 == 0 ? "heavy" : "wall", t, static_cast<long>(t / scene.dt)});
+  }
+  RunRecord b = a;
+  b.engine = "b";
+  for (auto _ : state) {
+    PairComparison pc = compare_pair(a, b, scene);
+    benchmark::DoNotOptimize(pc);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(contacts));
+}
+BENCHMARK(BM_ComparePairTwoPairsAlternating)->Arg(31416)->Unit(benchmark::kMillisecond);
+
 // What run_suite does for one contact-heavy scene of five engines: each run against the
 // reference, then the ten pairs, through one ScenarioComparer (the contacts' pair ids and
 // the scales computed once per run).

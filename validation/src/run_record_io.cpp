@@ -191,6 +191,13 @@ struct VectorSource {
     std::memcpy(p, in.data() + at, n);
     at += n;
   }
+  // The next n bytes when they are all at hand (then taken), else nullptr (nothing taken).
+  const char* take(std::size_t n) {
+    if (n > in.size() - at) return nullptr;
+    const char* p = reinterpret_cast<const char*>(in.data() + at);
+    at += n;
+    return p;
+  }
 };
 
 struct FdSource {
@@ -231,6 +238,13 @@ struct FdSource {
       n -= k;
     }
   }
+  // The next n bytes when the buffer holds them all (then taken), else nullptr (nothing taken).
+  const char* take(std::size_t n) {
+    if (n > end - begin) return nullptr;
+    const char* p = reinterpret_cast<const char*>(buffer.get() + begin);
+    begin += n;
+    return p;
+  }
 };
 
 template <class Source>
@@ -265,6 +279,8 @@ class Reader {
   }
   std::string str() {
     const std::uint64_t n = count();
+    // A string wholly in the source's buffer (names: nearly all) is made from it directly.
+    if (const char* p = src_.take(static_cast<std::size_t>(n))) return std::string(p, static_cast<std::size_t>(n));
     std::string s;
     // Read in pieces: a corrupt length cannot allocate more than arrives.
     while (s.size() < n) {

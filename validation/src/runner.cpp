@@ -290,6 +290,7 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     // Containment after every step (penetration depth, bodies through barriers): the
     // states are read each step for it, outside the timed step().
     ContainmentMonitor containment(scene);
+    containment.set_object_names([&engine](std::size_t i) { return engine->body_meta(i).name; });
     const long n = scene.steps();
     if (!sample(0.0)) {
       r.status = RunStatus::Diverged;

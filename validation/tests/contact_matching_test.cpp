@@ -98,6 +98,55 @@ TEST(ContactMatching, IndexedMatcherEqualsAllAgainstAllOnRandomContacts) {
   EXPECT_GT(checked_with_misses, 10);   // the trials exercise both matches and misses
 }
 
+// The pair ids remember the last few (a, b) met, and a list that does not go back and
+// forth stops looking at them after its first 256 contacts: long lists of each kind (two
+// or three pairs alternating, pi_billiard's; a gas of many pairs; one that turns from the
+// first kind to the second after the trial) match as the oracle does.
+TEST(ContactMatching, LongListsOfFewAndOfManyPairsMatchAsAllAgainstAll) {
+  std::mt19937 rng(20261124);
+  Scene scene;
+  scene.name = "contacts";
+  scene.dt = 0.01;
+  const double dt = 0.002;
+  std::uniform_real_distribution<double> noise(-0.04, 0.04);
+  auto alternating = [&](int count, int pairs, int swap_every) {
+    const char* names[4][2] = {{"light", "heavy"}, {"light", "wall"}, {"heavy", "wall"}, {"light", "floor"}};
+    std::vector<ContactRecord> out;
+    for (int k = 0; k < count; ++k) {
+      const auto& n = names[k % pairs];
+      const bool swap = swap_every > 0 && k % swap_every == 0;
+      out.push_back({swap ? n[1] : n[0], swap ? n[0] : n[1], 20.0 * k / count + noise(rng), k});
+    }
+    return out;
+  };
+  int missed = 0, matched_pairs = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    std::vector<ContactRecord> a, b;
+    if (trial % 3 == 0) {
+      a = alternating(900 + trial, 2 + trial % 3, trial % 2 == 0 ? 0 : 7);
+      b = alternating(880, 2 + trial % 3, 5);
+    } else if (trial % 3 == 1) {
+      a = random_contacts(rng, 700, 60, 20.0, 0.04);
+      b = random_contacts(rng, 650, 60, 20.0, 0.04);
+    } else {
+      a = alternating(300, 2, 0);
+      b = alternating(290, 2, 3);
+      const std::vector<ContactRecord> ga = random_contacts(rng, 500, 40, 20.0, 0.04), gb = random_contacts(rng, 480, 40, 20.0, 0.04);
+      a.insert(a.end(), ga.begin(), ga.end());
+      b.insert(b.end(), gb.begin(), gb.end());
+    }
+    const PairComparison pc = compare_pair(record_with("x", dt, a), record_with("y", dt, b), scene);
+    const OracleMatch want = all_against_all(b, a, std::max(5.0 * dt, 0.05));
+    ASSERT_EQ(pc.metrics.at("missed_contacts"), std::optional<double>(want.missed)) << "trial " << trial;
+    ASSERT_EQ(pc.metrics.at("extra_contacts"), std::optional<double>(want.extra)) << "trial " << trial;
+    ASSERT_EQ(pc.metrics.at("contact_time_error"), want.max_error) << "trial " << trial;
+    missed += want.missed;
+    matched_pairs += static_cast<int>(b.size()) - want.missed;
+  }
+  EXPECT_GT(missed, 0);
+  EXPECT_GT(matched_pairs, 0);
+}
+
 TEST(ContactMatching, MatchesSamePairWhicheverNameComesFirstAndCountsTheRest) {
   Scene scene;
   scene.name = "contacts";
