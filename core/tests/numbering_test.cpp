@@ -222,14 +222,13 @@ TEST(CoreNumbering, TheNotchGivesTheSameAnswerForEveryNumberingAndItsMirrorImage
 
 // A V wedge of two faces and three balls, symmetric about x = 0: every numbering and the
 // mirror image give the same states, and the left and right balls stay mirror images of
-// each other (the top ball on the axis). Not here: the frictionless 20-degree V at e = 0
-// with a 10x heavier top ball reaches the event cap (DISABLED_ test below).
+// each other (the top ball on the axis). The frictionless 20-degree V at e = 0 with a 10x
+// heavier top ball has its own test below.
 TEST(CoreNumbering, ASymmetricWedgeGivesASymmetricAnswerWhateverTheNumbering) {
   for (double e : {0.0, 0.3, 1.0}) {
     for (double mu : {0.0, 0.5}) {
       for (double slope : {20.0, 45.0}) {
         for (double m3 : {1.0, 10.0}) {
-          if (e == 0.0 && mu == 0.0 && slope == 20.0 && m3 == 10.0) continue;
           const std::string where = "V e " + std::to_string(e) + " mu " + std::to_string(mu) + " slope " +
                                     std::to_string(slope) + " m3 " + std::to_string(m3);
           check_numberings(v_wedge(slope, e, mu, m3), 150, bound(mu), where, {{0, 1}, {2, 2}});
@@ -254,11 +253,18 @@ TEST(CoreNumbering, APileGivesTheSameAnswerForEveryNumbering) {
   }
 }
 
-// OPEN: the frictionless V at 20 degrees, e = 0, top ball 10x heavier reaches the event
+// The frictionless V at 20 degrees, e = 0, top ball 10x heavier: it reached the event
 // cap at about 2 s, whatever the numbering (as before frictionless sliders joined the
 // simultaneous sets): the two lower balls pressed apart up frictionless faces by the
 // heavy one, a collapse core does not yet end.
-TEST(CoreNumbering, DISABLED_TheFrictionlessVWithAHeavyTopBallSettles) {
+// Measured again (branch numbering4, main 2153bdd): no event cap any more; what fails is the
+// mirror image (6.9e-2 m; every unmirrored numbering agrees). The runs agree to the bit (the
+// twins to 7e-15 m) until t = 2.0 s, when the two lower balls, pushed up the faces by the heavy
+// one, reach the faces' far ends (x = +-5.64 m: the contact point passes the end at step 120)
+// and go over the end corners; the mirrored scene meets its corner at the other end of the
+// segment (mirror_x swaps from and to). Passes since main ca64732 (branch corner2: a body
+// meeting a convex corner too slowly to bounce clear rides its cap), enabled unchanged.
+TEST(CoreNumbering, TheFrictionlessVWithAHeavyTopBallSettles) {
   check_numberings(v_wedge(20.0, 0.0, 0.0, 10.0), 150, 1e-10, "V e 0 mu 0 slope 20 m3 10", {{0, 1}, {2, 2}});
 }
 
@@ -273,7 +279,22 @@ TEST(CoreNumbering, DISABLED_TheFrictionlessVWithAHeavyTopBallSettles) {
 // 4.3e-4), 0.61 m (slot 0.6; mirror 0.33); e 1: 10-17 m (mirror 13 m). With mu 0.5: e 0,
 // slot 0.6: 6.1e-3 m (mirror 1.0e-3); e 0.3, slot 0.2: 9.5e-3 m (mirror 9.5e-3); the other
 // friction cases agree to 1e-12. Not the friction sets without a solution (numbering3's inelastic
-// fallback changes none of these numbers); cause not traced.
+// fallback changes none of these numbers).
+// Traced (branch numbering4), frictionless e 0: (1) fixed: d and e land on c at one instant
+// (c held in the slot on a and b, each against its wall); the set before left a and b at rest
+// against their walls but for 2.2e-16 m/s off them, which the next set read as separating from
+// the wall (measured against the ball's own speed): it lost the wall contacts and pushed a and b
+// into the walls at 0.32 m/s, and which ball kept such a residual followed the numbering (and
+// the walls' order). A face now joins a set when its approach is at rest to round-off of the
+// seed impact's speeds (simultaneous_impacts.cpp, touching_face). Slot 0.2: 6.4e-2 m -> 3.5e-3 m,
+// only bodies 4 3 2 1 0 still off. (2) open: there, the 8-contact frictionless solve (Gauss-
+// Seidel) leaves c at 1.4e-15 m/s into a and b (in the canonical run 1.1e-15 m/s away from
+// them), met at once as a micro-bounce that kicks c up at 4e-3 m/s. Snapping such a velocity to
+// 0 (as friction sets do) fixes it but fails FrictionlessPiles n10_e0_seed1_mu0 and makes
+// n50_e9_seed3_mu0 crawl for minutes. (3) open, slot 0.6: c is a leaf (at rest on bodies: its
+// faces only), so d-c and e-c, due at one instant, are two sets met one after the other.
+// Letting the seed pair's own bodies never be leaves makes every case here at e 0 and 0.3 pass
+// (e 1 still differs), but FrictionlessPiles n50_e9_seed3_mu0 then crawls for minutes.
 TEST(CoreNumbering, DISABLED_ABallDroppedIntoASlotGivesASymmetricAnswerWhateverTheNumbering) {
   for (double e : {0.0, 0.3, 1.0}) {
     for (double mu : {0.0, 0.5}) {
@@ -286,7 +307,8 @@ TEST(CoreNumbering, DISABLED_ABallDroppedIntoASlotGivesASymmetricAnswerWhateverT
   }
 }
 
-// OPEN: the frictionless 8-circle piles at e = 0 depend on the numbering by up to 1.5e-2 m.
+// OPEN: the frictionless 8-circle piles at e = 0 depend on the numbering by up to 1.5e-2 m
+// (measured again on main 2153bdd: 4.1e-2 m seed 1, 0.19 m seed 3; numbering4: 4.1e-2, 0.11 m).
 TEST(CoreNumbering, DISABLED_AFrictionlessInelasticPileGivesTheSameAnswerForEveryNumbering) {
   for (std::uint64_t seed : {1u, 3u}) {
     check_numberings(make_circle_pile(8, 0.0, 0.0, seed), 120, 1e-10, "pile of 8 e 0 mu 0 seed " + std::to_string(seed));
