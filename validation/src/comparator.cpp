@@ -848,7 +848,7 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
                              "' (a skipped impact: their straight paths overlapped by " + fmt(g.depth) + " m, " +
                              fmt(g.depth / std::min(scene.bodies[g.a].radius, scene.bodies[g.b].radius)) +
                              " of the smaller radius, in the step to t = " + fmt(g.time) +
-                             " s, apart at both ends; the reference's contact at t = " + fmt(*at) + " s)";
+                             " s, apart at its start, no impulse exchanged; the reference's contact at t = " + fmt(*at) + " s)";
           }
         }
       }
