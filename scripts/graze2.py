@@ -82,7 +82,11 @@ def main(argv):
                                 f'position = [0.0, 0.0]\nrestitution = 1.0\n')
                         open(os.path.join(scenes, name + ".toml"), "w").write(text)
                         va, vb = closed_form(off, v, ra, rb)
-                        truth[name] = dict(off=off, v=v, va=va, vb=vb, depth=(1 - off) * S / min(ra, rb), rmin=min(ra, rb),
+                        # The deepest overlap at a step's end on the straight flight: a pass an
+                        # engine sees overlapping there (already separating) is resolved as an
+                        # overlap; only what the path adds beyond it is judged (README).
+                        ends = max(max(0.0, S - math.hypot(x0 + v * k / hz, y0)) for k in range(0, 13))
+                        truth[name] = dict(end_depth=ends / min(ra, rb), off=off, v=v, va=va, vb=vb, depth=(1 - off) * S / min(ra, rb), rmin=min(ra, rb),
                                            slop=0.02)
     res = os.path.join(work, "out")
     p = subprocess.run([os.path.join(build, "physval"), "run", scenes, "--out", res, "-j", str(jobs), "--no-cache",
@@ -91,7 +95,7 @@ def main(argv):
         print(f"physval run exited {p.returncode}: {p.stderr[-400:]}", file=sys.stderr)
         return 2
     data = json.load(open(os.path.join(res, "results.json")))
-    wrong, false_red, skipped, struck, runs, capped = [], [], 0, 0, 0, 0
+    wrong, false_red, skipped, struck, runs, capped, at_end = [], [], 0, 0, 0, 0, 0
     for r in data["runs"]:
         if r["status"] == "unsupported":
             continue
@@ -114,7 +118,9 @@ def main(argv):
             # Box2D's own allowance: its time of impact stops a pair 3.25 linear slops
             # (3.25 x 5 mm) into each other by design, bullets or not (README).
             slop = max(t["slop"], 0.01625 / t["rmin"]) if r["engine"] == "box2d" else t["slop"]
-            if r["status"] == "ok" and t["depth"] > 1.001 * slop:
+            if r["status"] == "ok" and t["depth"] - t["end_depth"] <= 1.001 * slop:
+                at_end += 1   # seen overlapping at a step's end: left (README)
+            elif r["status"] == "ok" and t["depth"] > 1.001 * slop:
                 wrong.append(f"{r['scenario']} [{r['engine']}]: skipped the impact ({t['depth']:.3f} of the smaller "
                              f"radius deep on the straight path), `ok`")
         elif vbn > 0 and abs(math.hypot(*vb) - vbn) <= 0.25 * vbn:
@@ -127,7 +133,7 @@ def main(argv):
     for f in false_red:
         print("FALSE RED " + f)
     print(f"graze2: {len(truth)} scenes, {runs} runs ({skipped} skipped the impact, {struck} struck b near the "
-          f"closed form, {capped} with a speed-capped ball not judged): {len(wrong)} wrong greens, {len(false_red)} false reds")
+          f"closed form, {capped} with a speed-capped ball not judged, {at_end} `ok` skips whose depth a step's end already showed, left): {len(wrong)} wrong greens, {len(false_red)} false reds")
     return 1 if wrong or false_red else 0
 
 

@@ -583,13 +583,12 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
           std::min(ri, rj) > 0.0) {
         const Vec2 d0 = before(i) - before(j);
         const double slop = ContainmentRecord::kGrazeSlop * std::min(ri, rj);
-        // Apart at the start (no contact the engine could have acted on) and past the
-        // closest approach at the end (u <= 1: separating or tangent, so a discrete engine that finds
-        // the pair overlapping there exchanges no impulse, a restitution needs them closing):
-        // overlapping at the end is allowed. Overlapping at the start: the chord deeper in
-        // between than both ends by more than the slop.
-        const bool apart_at_start = length(d0) >= ri + rj - eps_;
-        const double ends = apart_at_start ? 0.0 : std::max({0.0, ri + rj - length(d0), ri + rj - closest});
+        // Past the closest approach at the end (u <= 1: separating or tangent there) and
+        // deeper in between than both ends by more than the slop: an end that overlaps is what
+        // a discrete engine sees and resolves (ODE in a 0.5 m/s gas of 3 cm balls found a
+        // pair 1 mm into each other, already separating, and pushed it apart), so only what
+        // the chord adds beyond it counts.
+        const double ends = std::max({0.0, ri + rj - length(d0), ri + rj - closest});
         {
           const Vec2 dd = (xi - xj) - d0;
           const double len2 = dot(dd, dd);
