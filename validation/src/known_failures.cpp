@@ -13,9 +13,10 @@ KnownFailures measured_known_failures(const ScenarioResult& scenario, double mar
     if (r.status == RunStatus::Unsupported) continue;
     auto& known = out[r.engine];
     // Bodies through barriers: the count itself (a count takes no margin).
-    if (r.containment.escaped_bodies && *r.containment.escaped_bodies > 0) {
-      known["escaped_bodies"] = *r.containment.escaped_bodies;
-    }
+    // (as judged: skipped impacts against the reference included, README "Metrics")
+    const std::optional<int> escaped = r.containment.judged_escaped_bodies ? r.containment.judged_escaped_bodies
+                                                                            : r.containment.escaped_bodies;
+    if (escaped && *escaped > 0) known["escaped_bodies"] = *escaped;
     // A bound system that came apart: E(end) / |E(0)|, with the margin.
     if (r.status == RunStatus::Diverged && r.unbound_ratio) known["energy_crossed_zero"] = *r.unbound_ratio * margin;
     // A bound system whose energy settled more than a quarter of its binding energy away: that

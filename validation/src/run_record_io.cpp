@@ -135,6 +135,16 @@ void write_record(Sink& sink, const RunRecord& r) {
   w.i64(c.escaped_bodies.value_or(0));
   w.opt(c.first_escape_time);
   w.str(c.first_escape);
+  w.u64(c.escaped_list.size());
+  for (const std::uint32_t k : c.escaped_list) w.u64(k);
+  w.u64(c.grazes.size());
+  for (const ContainmentRecord::Graze& g : c.grazes) {
+    w.u64(g.a);
+    w.u64(g.b);
+    w.f64(g.time);
+    w.f64(g.step);
+    w.f64(g.depth);
+  }
   w.u64(kMagic);
 }
 
@@ -420,6 +430,20 @@ RunRecord read_record(Source& source) {
   if (has_escaped) c.escaped_bodies = static_cast<int>(escaped);
   c.first_escape_time = rd.opt();
   c.first_escape = rd.str();
+  const std::uint64_t ne = rd.count();
+  reserve_some(c.escaped_list, ne);
+  for (std::uint64_t k = 0; k < ne; ++k) c.escaped_list.push_back(static_cast<std::uint32_t>(rd.u64()));
+  const std::uint64_t ng = rd.count();
+  reserve_some(c.grazes, ng);
+  for (std::uint64_t k = 0; k < ng; ++k) {
+    ContainmentRecord::Graze g;
+    g.a = static_cast<std::uint32_t>(rd.u64());
+    g.b = static_cast<std::uint32_t>(rd.u64());
+    g.time = rd.f64();
+    g.step = rd.f64();
+    g.depth = rd.f64();
+    c.grazes.push_back(g);
+  }
   if (rd.u64() != kMagic) throw std::runtime_error("run record: malformed (no end mark)");
   return r;
 }

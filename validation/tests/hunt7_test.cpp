@@ -10,6 +10,7 @@
 #include <string>
 
 #include "../src/containment.hpp"
+#include "physval/validation/comparator.hpp"
 #include "physval_command.hpp"
 
 namespace physval {
@@ -262,3 +263,155 @@ velocity = [1.0, 0.0]
 
 }  // namespace
 }  // namespace physval
+
+namespace physval {
+namespace {
+
+// graze2: a glancing impact skipped within one step, shallower than half the radius. Two
+// 0.5 m balls, a at 80 m/s passing a resting b 0.8 of the radii's sum off centre: on the
+// straight relative path they overlap by 0.2 m. Bullet, Chipmunk and ODE (and Box2D, its
+// ball capped to 60 m/s) leave both velocities unchanged and were `ok`, missed_contacts 1,
+// position_divergence 23.5 m, momentum and energy conserved (nothing happened). The
+// closed form (elastic, equal masses): a leaves at (51.2, 38.4), b at (28.8, -38.4) m/s.
+// The converged reference has the impact in that step: now `diverged`, reason naming the
+// pair, the depth and the reference's contact. Failed before (every engine `ok`).
+TEST_F(Hunt7, AGlancingImpactSkippedWithinAStepIsDiverged) {
+  for (const double off : {0.8, 0.9, 0.95}) {
+    const std::string text = "name = \"graze\"\nduration = 0.5\ndt = \"1/30\"\n[[bodies]]\nname = \"a\"\nradius = 0.5\n"
+                             "position = [-1.4, " + std::to_string(off) + "]\nvelocity = [80.0, 0.0]\nrestitution = 1.0\n"
+                             "[[bodies]]\nname = \"b\"\nradius = 0.5\nposition = [0.0, 0.0]\nrestitution = 1.0\n";
+    const fs::path scene = write("graze.toml", text);
+    const fs::path out = dir_ / "out";
+    fs::remove_all(out);
+    const Result r = physval("run " + scene.string() + " --quiet --no-cache --out " + out.string());
+    ASSERT_EQ(r.status, 1) << r.output;
+    std::ifstream in(out / "results.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    // The closed form's b: the normal from a to b at contact is (sqrt(1 - off^2), -off).
+    const double vn = 80.0 * std::sqrt(1.0 - off * off);
+    int skipped = 0;
+    for (const auto& run : j["runs"]) {
+      if (run["status"] == "unsupported") continue;
+      double vb = 0.0;
+      for (const auto& f : run["final"]) {
+        if (f["body"] == "b") vb = std::hypot(f["velocity"][0].get<double>(), f["velocity"][1].get<double>());
+      }
+      const std::string reason = run["reason"];
+      if (run["engine"] == "core") {
+        EXPECT_NEAR(vb, vn, 1e-6 * 80.0) << off;   // core meets the closed form
+        EXPECT_EQ(run["status"], "ok") << reason;
+        continue;
+      }
+      if (vb > 1e-6) continue;   // struck b: not a skipped impact
+      ++skipped;
+      EXPECT_EQ(run["status"], "diverged") << run["engine"] << " off " << off << ": " << reason;
+      EXPECT_EQ(run["metrics"]["escaped_bodies"], 2) << run["engine"];
+      EXPECT_NE(reason.find("a skipped impact"), std::string::npos) << reason;
+      EXPECT_NE(reason.find("the reference's contact at t = "), std::string::npos) << reason;
+    }
+    EXPECT_GE(skipped, 3) << off;   // Bullet, Chipmunk and ODE at least
+  }
+}
+
+// The monitor keeps such a pass (straight flights, the chord deeper than both ends by 2% of
+// the smaller radius, separating or tangent at the end) and not: a pass bent by
+// an impact inside the step, a pair closing at the end of the step (a discrete engine
+// resolves it at the next one), a pair pushed apart (deepest at the start), a pass within
+// the slop.
+TEST(Hunt7Containment, ASkippedGlancingImpactIsKeptForTheComparator) {
+  const double h = 1.0 / 30.0;
+  Scene s;
+  s.name = "graze";
+  s.dt = h;
+  BodyDef a;
+  a.name = "a";
+  a.radius = 0.5;
+  BodyDef b = a;
+  b.name = "b";
+  s.bodies = {a, b};
+  auto grazes = [&](Vec2 a0, Vec2 va0, Vec2 a1, Vec2 va1, Vec2 b1 = {0.0, 0.0}, Vec2 vb1 = {0.0, 0.0}) {
+    ContainmentMonitor m(s);
+    m.start({at(a0, va0), at({0.0, 0.0}, {0.0, 0.0})});
+    m.observe(h, {at(a1, va1), at(b1, vb1)});
+    EXPECT_EQ(*m.record().escaped_bodies, 0);
+    return m.record().grazes;
+  };
+  // 0.8 off: 0.2 m deep on the chord, apart at both ends.
+  auto g = grazes({-1.4, 0.8}, {80.0, 0.0}, {-1.4 + 80.0 * h, 0.8}, {80.0, 0.0});
+  ASSERT_EQ(g.size(), 1u);
+  EXPECT_EQ(g[0].a, 0u);
+  EXPECT_EQ(g[0].b, 1u);
+  EXPECT_NEAR(g[0].depth, 0.2, 1e-12);
+  EXPECT_DOUBLE_EQ(g[0].time, h);
+  // Ending 0.09 m into each other, past the closest approach (separating): the chord adds
+  // 0.11 m beyond that end, kept. Ending 0.194 m in (the chord adds 6 mm, below the 1 cm
+  // slop): what a discrete engine sees there and resolves as an overlap, not kept.
+  EXPECT_EQ(grazes({-1.9, 0.8}, {70.0, 0.0}, {-1.9 + 70.0 * h, 0.8}, {70.0, 0.0}).size(), 1u);
+  EXPECT_TRUE(grazes({-1.9, 0.8}, {60.0, 0.0}, {-1.9 + 60.0 * h, 0.8}, {60.0, 0.0}).empty());
+  // Ending overlapping and still closing: a discrete engine resolves it next step.
+  EXPECT_TRUE(grazes({-1.3, 0.8}, {30.0, 0.0}, {-1.3 + 30.0 * h, 0.8}, {30.0, 0.0}).empty());
+  // Bent by an impact inside the step: neither velocity gives the displacement.
+  EXPECT_TRUE(grazes({-1.4, 0.8}, {80.0, 0.0}, {-1.4 + 80.0 * h, 0.8}, {51.2, 38.4}, {0.0, 0.0}, {28.8, -38.4}).empty());
+  // Within the slop (2% of the radius: 0.99 off is 0.02 of it deep): not kept.
+  EXPECT_TRUE(grazes({-1.4, 0.995}, {80.0, 0.0}, {-1.4 + 80.0 * h, 0.995}, {80.0, 0.0}).empty());
+  // A pair 0.2 m into each other pushed apart: deepest at the start.
+  ContainmentMonitor m(s);
+  m.start({at({-0.4, 0.0}, {0.0, 0.0}), at({0.4, 0.0}, {0.0, 0.0})});
+  m.observe(h, {at({-0.5, 0.05}, {-3.0, 1.5}), at({0.5, 0.0}, {3.0, 0.0})});
+  EXPECT_TRUE(m.record().grazes.empty());
+}
+
+// The comparator calls a kept pass an escape only against a converged reference with a
+// contact of that pair within a step of it: a gas whose trajectories have left the
+// reference's (a contact of the pair elsewhere in time, or none) is not judged on it.
+TEST(Hunt7Containment, ASkippedImpactNeedsTheReferencesContactInThatStep) {
+  const double h = 1.0 / 30.0;
+  Scene s;
+  s.name = "graze";
+  s.dt = h;
+  s.duration = 10 * h;
+  BodyDef a;
+  a.name = "a";
+  a.radius = 0.5;
+  BodyDef b = a;
+  b.name = "b";
+  b.position = {3.0, 0.0};
+  s.bodies = {a, b};
+  auto judged = [&](std::optional<double> ref_contact, bool converged, const std::string& engine = "bullet",
+                    double depth = 0.2) {
+    RunRecord run;
+    run.engine = engine;
+    run.dt = h;
+    if (engine == "box2d") run.settings.push_back({"linear_slop", "0.005 m (compiled in)"});
+    run.containment.measured = true;
+    run.containment.escaped_bodies = 0;
+    run.containment.grazes.push_back({0, 1, 4 * h, h, depth});
+    Reference ref;
+    ref.available = true;
+    ref.converged = converged;
+    ref.dt = h / 8;
+    ref.run = RunRecord{};
+    if (ref_contact) ref.run->contacts.push_back({"b", "a", *ref_contact, 1});
+    compare_run(run, s, ref, false);
+    return run;
+  };
+  const RunRecord in_step = judged(3.5 * h, true);
+  EXPECT_EQ(in_step.status, RunStatus::Diverged) << in_step.reason;
+  EXPECT_EQ(*in_step.metrics.at("escaped_bodies"), 2.0);
+  EXPECT_NE(in_step.reason.find("a skipped impact"), std::string::npos) << in_step.reason;
+  EXPECT_EQ(judged(2.2 * h, true).status, RunStatus::Diverged);   // a step before
+  EXPECT_EQ(judged(5.0 * h, true).status, RunStatus::Diverged);   // a step after
+  EXPECT_EQ(judged(1.5 * h, true).status, RunStatus::Ok);          // further: another encounter
+  EXPECT_EQ(judged(6.5 * h, true).status, RunStatus::Ok);
+  EXPECT_EQ(judged(std::nullopt, true).status, RunStatus::Ok);     // the reference never meets them
+  EXPECT_EQ(judged(3.5 * h, false).status, RunStatus::Ok);         // no converged reference
+  // Box2D's time of impact lets a pair 3.25 linear slops (16.25 mm) into each other by
+  // design: a bullet gas skipped a 5 mm graze. Deeper is its miss.
+  EXPECT_EQ(judged(3.5 * h, true, "box2d", 0.01).status, RunStatus::Ok);
+  EXPECT_EQ(judged(3.5 * h, true, "box2d", 0.02).status, RunStatus::Diverged);
+  EXPECT_EQ(judged(3.5 * h, true, "bullet", 0.01).status, RunStatus::Diverged);
+}
+
+}  // namespace
+}  // namespace physval
+

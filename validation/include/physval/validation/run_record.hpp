@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -103,6 +104,29 @@ struct ContainmentRecord {
   std::optional<int> escaped_bodies;        // nullopt: no barrier any scene body collides with
   std::optional<double> first_escape_time;  // s, the end of the step the first escape happened in
   std::string first_escape;                 // "ball through wall 'left'"
+  // The scene bodies counted in escaped_bodies (indices), so that a pass judged later
+  // (below) counts each body once.
+  std::vector<std::uint32_t> escaped_list;
+  // Passes between two moving scene bodies too shallow for an escape by themselves: apart
+  // at both ends of a step, each on one straight flight at an unchanged velocity (nothing
+  // was exchanged in it), their straight relative path overlapping by `depth` m (more
+  // than a slop of kGrazeSlop x the smaller radius). The comparator calls such a pass an
+  // escape when the converged reference has a contact of that pair in that step (within a
+  // step either side): the engine skipped an impact the reference makes (README
+  // "Metrics", escaped_bodies). At most kMaxGrazes are kept (the first ones).
+  struct Graze {
+    std::uint32_t a = 0, b = 0;   // scene body indices
+    double time = 0.0;            // s, the end of the step
+    double step = 0.0;            // s, its length
+    double depth = 0.0;           // m, the straight relative path's deepest overlap
+  };
+  static constexpr double kGrazeSlop = 0.02;
+  static constexpr std::size_t kMaxGrazes = 10000;
+  std::vector<Graze> grazes;
+  // Set by the comparator (not written anywhere): the escapes it judged, the record's and
+  // the skipped impacts together (the run's escaped_bodies metric), and the first's time.
+  std::optional<int> judged_escaped_bodies;
+  std::optional<double> judged_first_escape_time;
 };
 
 struct RunRecord {
