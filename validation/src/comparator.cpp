@@ -814,25 +814,8 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
       for (const std::uint32_t k : run.containment.escaped_list) {
         if (k < counted.size()) counted[k] = 1;
       }
-      // The engine's own allowance, beyond the monitor's 2% of the smaller radius: Box2D's
-      // time of impact stops a pair at a separation of the radii's sum less 3 linear slops,
-      // within a quarter slop (b2TimeOfImpact's target and tolerance), so even its bullets
-      // pass up to 3.25 x 5 mm into each other by design: a 400-ball bullet gas at 3 m/s
-      // (radius 0.1 m) skipped a contact 5 mm deep, and the third hunt saw 1.3 cm.
-      double engine_slop = 0.0;
-      if (run.engine == "box2d") {
-        for (const Setting& st : run.settings) {
-          if (st.first != "linear_slop") continue;
-          try {
-            engine_slop = 3.25 * std::stod(st.second);
-          } catch (const std::exception&) {
-            engine_slop = 3.25 * 0.005;
-          }
-        }
-      }
       for (const ContainmentRecord::Graze& g : run.containment.grazes) {
         if (g.a >= scene.bodies.size() || g.b >= scene.bodies.size()) continue;
-        if (!(g.depth > engine_slop)) continue;
         const auto it = ref_times.find(pair_key(scene.bodies[g.a].name, scene.bodies[g.b].name));
         if (it == ref_times.end()) continue;
         const double from = g.time - 2.0 * g.step, to = g.time + g.step;
