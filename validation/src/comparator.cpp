@@ -815,22 +815,28 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
         if (k < counted.size()) counted[k] = 1;
       }
       for (const ContainmentRecord::Graze& g : run.containment.grazes) {
-        if (g.a >= scene.bodies.size() || g.b >= scene.bodies.size()) continue;
-        const auto it = ref_times.find(pair_key(scene.bodies[g.a].name, scene.bodies[g.b].name));
+        // b past the bodies: a wall (its end point), graze3.
+        if (g.a >= scene.bodies.size() || g.b >= scene.bodies.size() + scene.walls.size()) continue;
+        const bool wall = g.b >= scene.bodies.size();
+        const std::string other = wall ? scene.walls[g.b - scene.bodies.size()].name : scene.bodies[g.b].name;
+        const auto it = ref_times.find(pair_key(scene.bodies[g.a].name, other));
         if (it == ref_times.end()) continue;
         const double from = g.time - 2.0 * g.step, to = g.time + g.step;
         const auto at = std::find_if(it->second.begin(), it->second.end(), [&](double x) { return x >= from && x <= to; });
         if (at == it->second.end()) continue;
         for (const std::uint32_t k : {g.a, g.b}) {
-          if (counted[k]) continue;
+          if (k >= counted.size() || scene.bodies[k].is_static || counted[k]) continue;
           counted[k] = 1;
           *c.escaped_bodies += 1;
           if (!c.first_escape_time || g.time < *c.first_escape_time) {
             c.first_escape_time = g.time;
-            c.first_escape = scene.bodies[k].name + " into body '" + scene.bodies[k == g.a ? g.b : g.a].name +
-                             "' (a skipped impact: their straight paths overlapped by " + fmt(g.depth) + " m, " +
-                             fmt(g.depth / std::min(scene.bodies[g.a].radius, scene.bodies[g.b].radius)) +
-                             " of the smaller radius, in the step to t = " + fmt(g.time) +
+            const bool fixed = wall || scene.bodies[g.b].is_static;   // the monitor's slop: the moving body's radius
+            const double radius = fixed ? scene.bodies[g.a].radius : std::min(scene.bodies[g.a].radius, scene.bodies[g.b].radius);
+            c.first_escape = scene.bodies[k].name + " into " +
+                             (wall ? "the end of wall '" + other + "'" : "body '" + scene.bodies[k == g.a ? g.b : g.a].name + "'") +
+                             " (a skipped impact: their straight paths overlapped by " + fmt(g.depth) + " m, " +
+                             fmt(g.depth / radius) + (fixed ? " of its radius" : " of the smaller radius") +
+                             ", in the step to t = " + fmt(g.time) +
                              " s, apart at its start, no impulse exchanged; the reference's contact at t = " + fmt(*at) + " s)";
           }
         }

@@ -60,6 +60,7 @@ class ContainmentMonitor {
     double radius = 0.0;   // circles
     std::size_t group = 0;   // index into barrier groups
     std::size_t body = static_cast<std::size_t>(-1);   // a static body's index
+    std::size_t wall = static_cast<std::size_t>(-1);   // a wall's index in scene.walls
     std::string what;      // "wall 'left'"
   };
   void candidates(Vec2 lo, Vec2 hi);

@@ -448,6 +448,112 @@ TEST_F(Hunt7, ASmallBallsSkippedImpactIsDivergedOnBox2DToo) {
   EXPECT_TRUE(saw_box2d);
 }
 
+// graze3: the same skip against what does not move. A 0.5 m ball at 80 m/s passing a
+// static 0.5 m ball 0.8 of the radii's sum off its centre, or 0.3 m off the end of a thin
+// wall, within one 1/30 s step: its straight path is 0.2 m (0.4 r) into the static circle
+// or the end point. Bullet, Chipmunk and ODE leave its velocity unchanged and were `ok`
+// (grazes were recorded between moving bodies only). The closed forms (reflection off the
+// normal at contact, n = (-0.6, -0.8) and (-0.8, 0.6)) are met by core. Failed before.
+TEST_F(Hunt7, ASkippedImpactOnAStaticBallOrAWallsEndIsDiverged) {
+  const std::string ball = "[[bodies]]\nname = \"a\"\nradius = 0.5\nposition = [-1.4, Y]\nvelocity = [80.0, 0.0]\n"
+                           "restitution = 1.0\n";
+  const std::string head = "name = \"graze\"\nduration = 0.5\ndt = \"1/30\"\n";
+  struct Case {
+    std::string text, other;
+    double vx, vy;
+  };
+  auto with_y = [&](const std::string& y) { return head + ball.substr(0, ball.find('Y')) + y + ball.substr(ball.find('Y') + 1); };
+  const Case cases[] = {
+      {with_y("0.8") + "[[bodies]]\nname = \"b\"\nradius = 0.5\nposition = [0.0, 0.0]\nstatic = true\nrestitution = 1.0\n",
+       "body 'b'", 22.4, 76.8},
+      {with_y("0.3") + "[[walls]]\nname = \"post\"\nfrom = [0.0, -5.0]\nto = [0.0, 0.0]\nrestitution = 1.0\n",
+       "the end of wall 'post'", -22.4, 76.8},
+  };
+  for (const Case& c : cases) {
+    const fs::path scene = write("graze.toml", c.text);
+    const fs::path out = dir_ / "out";
+    fs::remove_all(out);
+    const Result r = physval("run " + scene.string() + " --quiet --no-cache --out " + out.string());
+    ASSERT_EQ(r.status, 1) << r.output;
+    std::ifstream in(out / "results.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    int skipped = 0;
+    for (const auto& run : j["runs"]) {
+      if (run["status"] == "unsupported") continue;
+      Vec2 v{};
+      for (const auto& f : run["final"]) {
+        if (f["body"] == "a") v = {f["velocity"][0].get<double>(), f["velocity"][1].get<double>()};
+      }
+      const std::string reason = run["reason"];
+      if (run["engine"] == "core") {
+        EXPECT_NEAR(v.x, c.vx, 1e-6) << c.other;
+        EXPECT_NEAR(v.y, c.vy, 1e-6) << c.other;
+        EXPECT_EQ(run["status"], "ok") << reason;
+        continue;
+      }
+      if (std::fabs(v.x - 80.0) > 1e-9 || std::fabs(v.y) > 1e-9) continue;   // struck: not a skip
+      ++skipped;
+      EXPECT_EQ(run["status"], "diverged") << run["engine"] << " " << c.other << ": " << reason;
+      EXPECT_EQ(run["metrics"]["escaped_bodies"], 1) << run["engine"];
+      EXPECT_NE(reason.find("a into " + c.other + " (a skipped impact"), std::string::npos) << reason;
+    }
+    EXPECT_GE(skipped, 3) << c.other;   // Bullet, Chipmunk and ODE
+  }
+}
+
+// The monitor keeps a skip past a static circle or a wall's end point, and not: a ball
+// rolling off the end of a floor it rests on (overlapping the wall at both ends: what a
+// discrete engine sees and resolves), a pass within 2% of the radius, a bounced step.
+TEST(Hunt7Containment, ASkippedImpactOnAStaticIsKeptForTheComparator) {
+  const double h = 1.0 / 30.0;
+  Scene s;
+  s.name = "graze";
+  s.dt = h;
+  BodyDef a;
+  a.name = "a";
+  a.radius = 0.5;
+  s.bodies = {a};
+  WallDef w;
+  w.name = "post";
+  w.from = {0.0, -5.0};
+  w.to = {0.0, 0.0};
+  s.walls = {w};
+  auto grazes = [&](Vec2 a0, Vec2 va0, Vec2 a1, Vec2 va1) {
+    ContainmentMonitor m(s);
+    m.start({at(a0, va0)});
+    m.observe(h, {at(a1, va1)});
+    EXPECT_EQ(*m.record().escaped_bodies, 0);
+    return m.record().grazes;
+  };
+  auto g = grazes({-1.4, 0.3}, {80.0, 0.0}, {-1.4 + 80.0 * h, 0.3}, {80.0, 0.0});
+  ASSERT_EQ(g.size(), 1u);
+  EXPECT_EQ(g[0].a, 0u);
+  EXPECT_EQ(g[0].b, 1u);   // the wall, past the one body
+  EXPECT_NEAR(g[0].depth, 0.2, 1e-12);
+  EXPECT_TRUE(grazes({-1.4, 0.495}, {80.0, 0.0}, {-1.4 + 80.0 * h, 0.495}, {80.0, 0.0}).empty());   // 1%
+  EXPECT_TRUE(grazes({-1.4, 0.3}, {80.0, 0.0}, {-1.4 + 80.0 * h, 0.3}, {-22.4, 76.8}).empty());     // bounced
+  // Resting 5 mm into a floor, rolling off its end at 3 m/s.
+  WallDef floor;
+  floor.name = "floor";
+  floor.from = {-5.0, 0.0};
+  floor.to = {0.0, 0.0};
+  s.walls = {floor};
+  EXPECT_TRUE(grazes({-0.05, 0.495}, {3.0, 0.0}, {-0.05 + 3.0 * h, 0.495}, {3.0, 0.0}).empty());
+  // A static ball: the moving one passes 0.2 m into it.
+  s.walls.clear();
+  BodyDef b = a;
+  b.name = "b";
+  b.is_static = true;
+  s.bodies = {a, b};
+  ContainmentMonitor m(s);
+  m.start({at({-1.4, 0.8}, {80.0, 0.0}), at({0.0, 0.0}, {0.0, 0.0})});
+  m.observe(h, {at({-1.4 + 80.0 * h, 0.8}, {80.0, 0.0}), at({0.0, 0.0}, {0.0, 0.0})});
+  ASSERT_EQ(m.record().grazes.size(), 1u);
+  EXPECT_EQ(m.record().grazes[0].a, 0u);
+  EXPECT_EQ(m.record().grazes[0].b, 1u);
+  EXPECT_NEAR(m.record().grazes[0].depth, 0.2, 1e-12);
+}
+
 }  // namespace
 }  // namespace physval
 
