@@ -722,7 +722,16 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
           const double closest_at = dot(c - p0, d) / len2;   // 1: at the end
           const double u = std::clamp(closest_at, 0.0, 1.0);
           const double along = length(p0 + d * u - c);
-          const double limit = reach - ends - slop;
+          double limit = reach - ends - slop;
+          if (along < limit && !b.circle) {
+            // An end point shared with another segment (a ledge's corner, a loop's): the
+            // ends' overlap with that one counts too (a ball resting a slop deep on a floor
+            // rolls over its corner with the wall below: the floor is being resolved).
+            for (const Barrier& o : barriers_) {
+              if (o.circle || (o.a != c && o.b != c)) continue;
+              for (const Vec2 q : {p0, p1}) limit = std::min(limit, reach - slop - (r - segment_distance(q, o.a, o.dir, o.len)));
+            }
+          }
           if (along < limit && closest_at <= 1.0 + 1e-9 && u > 0.0) {
             const double off = straight_either(i);
             if (off < 0.25 * slop && along + off < limit) {

@@ -539,6 +539,19 @@ TEST(Hunt7Containment, ASkippedImpactOnAStaticIsKeptForTheComparator) {
   floor.to = {0.0, 0.0};
   s.walls = {floor};
   EXPECT_TRUE(grazes({-0.05, 0.495}, {3.0, 0.0}, {-0.05 + 3.0 * h, 0.495}, {3.0, 0.0}).empty());
+  // Over a ledge: the floor's end is the corner of a wall going down. A 0.1 m ball resting
+  // 5 mm deep on the floor passes that corner 5 mm into it, apart from the wall below at
+  // both ends (2.5 times the 2 mm slop), but the floor is being resolved: not kept.
+  WallDef drop;
+  drop.name = "drop";
+  drop.from = {0.0, 0.0};
+  drop.to = {0.0, -5.0};
+  s.walls = {floor, drop};
+  s.bodies[0].radius = 0.1;
+  EXPECT_TRUE(grazes({-0.05, 0.095}, {3.0, 0.0}, {-0.05 + 3.0 * h, 0.095}, {3.0, 0.0}).empty());
+  s.walls = {drop};   // without the floor it is a skip of the corner
+  EXPECT_EQ(grazes({-0.05, 0.095}, {3.0, 0.0}, {-0.05 + 3.0 * h, 0.095}, {3.0, 0.0}).size(), 1u);
+  s.bodies[0].radius = 0.5;
   // A static ball: the moving one passes 0.2 m into it.
   s.walls.clear();
   BodyDef b = a;
