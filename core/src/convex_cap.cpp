@@ -154,8 +154,9 @@ bool cap_alone(const World& w, std::uint32_t i, double dt) {
   return true;
 }
 
-// Body i leaves the cap at time te with state s: onto a face, or free.
-void leave_cap(World& w, std::uint32_t i, const Ride& c, State s, Exit why, double te, double t_abs, double dt) {
+// Body i leaves the cap at time te with state s: onto a face, or free. The ride is taken
+// by value: erasing it from w.caps below would leave a reference into the map dangling.
+void leave_cap(World& w, std::uint32_t i, const Ride c, State s, Exit why, double te, double t_abs, double dt) {
   const double r = w.radius[i];
   w.caps.erase(i);
   const Vec2 n = cap_n(c, s.phi);
