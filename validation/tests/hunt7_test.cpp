@@ -33,6 +33,20 @@ BodyState at(Vec2 x, Vec2 v, bool alive = true) {
   return s;
 }
 
+// Two 0.5 m balls a and b at the origin, stepped at h: the graze tests' scene.
+Scene two_balls(const char* name, double h) {
+  Scene s;
+  s.name = name;
+  s.dt = h;
+  BodyDef a;
+  a.name = "a";
+  a.radius = 0.5;
+  BodyDef b = a;
+  b.name = "b";
+  s.bodies = {a, b};
+  return s;
+}
+
 // A particle is a point of its parent's group: one whose straight path from one step to
 // the next crosses a wall is an escape, like a scene body's; one leaving its own static
 // parent's circle (a fountain) is not, and one in a group the walls let through is not.
@@ -155,15 +169,7 @@ TEST_F(Hunt7, ParticlesThroughTheWallsOfAClosedBoxAreEscapes) {
 TEST(Hunt7Containment, APassInBox2DsSpeedClampedStepIsAnEscape) {
   const double h = 1.0 / 30.0;
   for (const double off : {0.6, 0.65, 0.7, 0.74}) {
-    Scene s;
-    s.name = "graze";
-    s.dt = h;
-    BodyDef a;
-    a.name = "a";
-    a.radius = 0.5;
-    BodyDef b = a;
-    b.name = "b";
-    s.bodies = {a, b};
+    const Scene s = two_balls("graze", h);
     const Vec2 a0{-1.4, off}, a1{0.6, off};
     ContainmentMonitor m(s);
     m.start({at(a0, {80.0, 0.0}), at({0.0, 0.0}, {0.0, 0.0})});
@@ -181,15 +187,7 @@ TEST(Hunt7Containment, APassInBox2DsSpeedClampedStepIsAnEscape) {
     EXPECT_EQ(*bent.record().escaped_bodies, 0) << "off " << off;
   }
   // A pair 0.2 m into each other pushed apart along its normal: deepest at the start.
-  Scene s;
-  s.name = "apart";
-  s.dt = h;
-  BodyDef a;
-  a.name = "a";
-  a.radius = 0.5;
-  BodyDef b = a;
-  b.name = "b";
-  s.bodies = {a, b};
+  const Scene s = two_balls("apart", h);
   ContainmentMonitor m(s);
   m.start({at({-0.4, 0.0}, {0.0, 0.0}), at({0.4, 0.0}, {0.0, 0.0})});
   m.observe(h, {at({-0.5, 0.05}, {-3.0, 1.5}), at({0.5, 0.0}, {3.0, 0.0})});
@@ -320,15 +318,7 @@ TEST_F(Hunt7, AGlancingImpactSkippedWithinAStepIsDiverged) {
 // the slop.
 TEST(Hunt7Containment, ASkippedGlancingImpactIsKeptForTheComparator) {
   const double h = 1.0 / 30.0;
-  Scene s;
-  s.name = "graze";
-  s.dt = h;
-  BodyDef a;
-  a.name = "a";
-  a.radius = 0.5;
-  BodyDef b = a;
-  b.name = "b";
-  s.bodies = {a, b};
+  const Scene s = two_balls("graze", h);
   auto grazes = [&](Vec2 a0, Vec2 va0, Vec2 a1, Vec2 va1, Vec2 b1 = {0.0, 0.0}, Vec2 vb1 = {0.0, 0.0}) {
     ContainmentMonitor m(s);
     m.start({at(a0, va0), at({0.0, 0.0}, {0.0, 0.0})});
@@ -366,17 +356,9 @@ TEST(Hunt7Containment, ASkippedGlancingImpactIsKeptForTheComparator) {
 // reference's (a contact of the pair elsewhere in time, or none) is not judged on it.
 TEST(Hunt7Containment, ASkippedImpactNeedsTheReferencesContactInThatStep) {
   const double h = 1.0 / 30.0;
-  Scene s;
-  s.name = "graze";
-  s.dt = h;
+  Scene s = two_balls("graze", h);
   s.duration = 10 * h;
-  BodyDef a;
-  a.name = "a";
-  a.radius = 0.5;
-  BodyDef b = a;
-  b.name = "b";
-  b.position = {3.0, 0.0};
-  s.bodies = {a, b};
+  s.bodies[1].position = {3.0, 0.0};
   auto judged = [&](std::optional<double> ref_contact, bool converged, const std::string& engine = "bullet",
                     double depth = 0.2) {
     RunRecord run;
