@@ -1388,9 +1388,13 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
                            inf_norm(after) <= kGapUlps * kEps * inf_norm(before)) ||
                           inf_norm(after) <= 4.0 * kEps * inf_norm(before) ||
                           inf_norm(after) <= kGapUlps * kEps * local;
-    w.vel[bodies[s]] = residual ? Vec2{} : after;
+    if (w.sim_dry_run) {
+      w.sim_trial.emplace_back(bodies[s], residual ? Vec2{} : after);
+    } else {
+      w.vel[bodies[s]] = residual ? Vec2{} : after;
+    }
   }
-  w.stats.impacts += static_cast<std::int64_t>(K) - 1;
+  if (!w.sim_dry_run) w.stats.impacts += static_cast<std::int64_t>(K) - 1;
   return true;
 }
 

@@ -137,6 +137,11 @@ struct World {
   // contact's restitution 0, collapse_speed infinite) when Newton's law with the
   // separating contacts would raise its kinetic energy (see exact_collisions.cpp).
   bool sim_inelastic = false;
+  // Set by the event loop to try a set's law without changing a velocity: the velocities it
+  // would set go to sim_trial (body, velocity after), w.vel and the stats are left as they
+  // were (its bodies are advanced to the impact's time, as the solve that follows would).
+  bool sim_dry_run = false;
+  std::vector<std::pair<std::uint32_t, Vec2>> sim_trial;
   BroadPhaseKind broadphase = BroadPhaseKind::Grid;
   bool broadphase_auto = true;
   double cell_size = 0.0;
