@@ -788,9 +788,11 @@ class EventLoop {
       }
     }
     if (cycling) cycle_vel_.assign(w_.vel.begin(), w_.vel.end());
+    bool stopped = false;
     if (!settled && !isolated && !cycling && min_sep > 0.0 && closing > rest_vr &&
         (m.friction > 0.0 || m.static_friction > 0.0) && stopped_and_held(i, j, t, t_abs)) {
       settled = true;   // stopped by the impact, held where it stopped
+      stopped = true;   // its set's contacts recorded as a set's are
     }
     bool simultaneous = !settled && !isolated && resolve_simultaneous(w_, i, j, t, set_, impacted_, min_sep);
     if (simultaneous && cycling && set_gained_energy()) {
@@ -830,7 +832,7 @@ class EventLoop {
         after_velocity_change(j);
       }
     }
-    if (r.event) record_contact(w_, i, j, nullptr, t_abs, ctx_.dt);
+    if (r.event && !stopped) record_contact(w_, i, j, nullptr, t_abs, ctx_.dt);
     ++w_.version[i];
     ++w_.version[j];
     destroy_after(i, r.destroy_first);
@@ -898,9 +900,11 @@ class EventLoop {
       w_.apath[moved] = a_moved;
       return false;
     }
-    for (const BodyPair& p : impacted_) {
+    for (const BodyPair& p : impacted_) {   // as finish_simultaneous records them, in order
       if (p.a & kSimultaneousFace) {
         record_contact(w_, p.b, kNone, &w_.statics.segments[p.a & ~kSimultaneousFace], t_abs, ctx_.dt);
+      } else {
+        record_contact(w_, p.a, p.b, nullptr, t_abs, ctx_.dt);
       }
     }
     return true;
