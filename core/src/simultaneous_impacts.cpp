@@ -543,6 +543,18 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   const bool friction = R > K;
   const int max_iter = friction ? 20000 : 100000;
   const double stop = 4.0 * kEps;
+  // A friction set whose sweeps have come to 1e-10 of its largest impulse (about 2/3 of the
+  // way to round-off: ~80 of ~125 sweeps in the 50-circle pile) is solved exactly on the
+  // contact states the sweeps reached (polish_friction's elimination, in the order of the
+  // geometry), and that answer is kept when it meets every condition of the law to
+  // round-off (impulses >= 0 and within the cones, each contact at or above its target, each
+  // active one at it, sliders sliding against their friction); else the sweeps go on to
+  // round-off as before. Checked on the 50-circle pile (3 runs, 64,000 sets): the exact
+  // answers meet the law to at most 2.1 ulps of each contact's own speed scale (median 4e-4),
+  // where the sweeps' answers exceed 4 ulps in 243 sets (up to the whole scale: the stop is
+  // relative to the set's largest impulse, so a lightly loaded contact can keep a residual
+  // its own speeds would not); 76% of the sets end here (README, Benchmarks).
+  constexpr double kExactAt = 1e-10;
   double pmax = 0.0;
   // Each body's rows (CSR: terms[term_start[s] .. term_start[s + 1]) for body slot s),
   // with the sign of the row's impulse on it (-1 on a, +1 on b).
@@ -738,8 +750,11 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   // Whether the last friction_solve's answer meets its law: Jacobi converged, or its
   // velocities meet the contact states it reached, or the exact solve found them.
   bool friction_ok = true;
-  const auto polish_friction = [&](int law) {
-    if (R > 24) return;
+  // exact_only (the sweeps' early exact solve, friction_solve): only the exact solve of the
+  // states the sweeps reached, and only in a set with no tie in the order of its unknowns
+  // (a mirror pair: the elimination would follow the numbering); true if it met the law.
+  const auto polish_friction = [&](int law, bool exact_only = false) -> bool {
+    if (R > 24) return false;
     pf_M.assign(R * R, 0.0);
     for (std::size_t k = 0; k < R; ++k) {
       for (std::size_t l = 0; l < R; ++l) {
@@ -774,9 +789,15 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       return std::tuple<double, double, double, double>{m.y, std::fabs(m.x), std::fabs(x.n.y), std::fabs(x.n.x)};
     };
     std::stable_sort(pf_order.begin(), pf_order.end(), [&](std::size_t x, std::size_t y) { return place(x) < place(y); });
+    if (exact_only) {
+      for (std::size_t c = 1; c < K; ++c) {
+        if (!(place(pf_order[c - 1]) < place(pf_order[c]))) return false;
+      }
+    }
     const auto attempt = [&]() -> bool {
       // unknowns: the normal impulse of each contact on, the tangent one of each sticking
-      std::vector<std::size_t> eq;   // the row each unknown's equation is on
+      thread_local std::vector<std::size_t> eq;   // the row each unknown's equation is on
+      eq.clear();
       for (std::size_t c : pf_order) {
         if (pf_state[c] == 0) continue;
         eq.push_back(pf_nrow[c]);
@@ -786,26 +807,27 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       if (n == 0) return false;
       // column of unknown u: the velocity change per unit of it, on every row
       pf_G.assign(n * (n + 1), 0.0);
-      std::vector<std::vector<double>> col(n, std::vector<double>(R, 0.0));
+      thread_local std::vector<double> col;   // unknown u's column on row r: col[u * R + r]
+      col.assign(n * R, 0.0);
       {
         std::size_t u = 0;
         for (std::size_t c : pf_order) {
           if (pf_state[c] == 0) continue;
           const std::size_t kn = pf_nrow[c], kt = pf_trow[c];
-          for (std::size_t r = 0; r < R; ++r) col[u][r] = pf_M[r * R + kn];
+          for (std::size_t r = 0; r < R; ++r) col[u * R + r] = pf_M[r * R + kn];
           if (pf_state[c] >= 2 && kt < R) {
             const double sgn = pf_state[c] == 2 ? 1.0 : -1.0;
-            for (std::size_t r = 0; r < R; ++r) col[u][r] += sgn * contacts[c].mu_k * pf_M[r * R + kt];
+            for (std::size_t r = 0; r < R; ++r) col[u * R + r] += sgn * contacts[c].mu_k * pf_M[r * R + kt];
           }
           ++u;
           if (pf_state[c] == 1 && kt < R) {
-            for (std::size_t r = 0; r < R; ++r) col[u][r] = pf_M[r * R + kt];
+            for (std::size_t r = 0; r < R; ++r) col[u * R + r] = pf_M[r * R + kt];
             ++u;
           }
         }
       }
       for (std::size_t i = 0; i < n; ++i) {
-        for (std::size_t j = 0; j < n; ++j) pf_G[i * (n + 1) + j] = col[j][eq[i]];
+        for (std::size_t j = 0; j < n; ++j) pf_G[i * (n + 1) + j] = col[j * R + eq[i]];
         const std::size_t r = eq[i];
         const double tgt = rows[r].tangent ? ttarget(rows[r].contact) : ntarget(rows[r].contact);
         pf_G[i * (n + 1) + n] = tgt - w0[r];
@@ -879,6 +901,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
         if (std::fabs(pt) >= contacts[c].mu_s * pn * (1.0 - 1e-9)) pf_state[c] = pt > 0.0 ? 2 : 3;
       }
     }
+    if (exact_only) return attempt();
     // Jacobi's velocities already meet them to round-off (its impulses drifting along a
     // family of solutions, as in a ball wedged with friction, whose velocities are
     // settled): its answer stands, the same to the last bit for every numbering (the
@@ -900,6 +923,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       if (settled && kt < R && pf_state[c] == 1 && std::fabs(wplus(kt) - ttarget(c)) > tol) settled = false;
     }
     friction_ok = settled || attempt();
+    return friction_ok;
   };
   const auto friction_solve = [&](int law) {
     bool converged = false;
@@ -966,6 +990,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       }
     }
     const SweepPair* const sp = sweep_pair.data();
+    bool tried_exact = R > 24;
     for (int iter = 0; iter < max_iter; ++iter) {
       double change = 0.0;
       for (std::size_t j = 0; paired && j < K; ++j) {
@@ -1010,6 +1035,20 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       }
       std::swap(pc, pq);
       swapped = !swapped;
+      // Nearly converged: the exact solve of the states reached (see kExactAt).
+      if (!tried_exact && change <= kExactAt * pm) {
+        tried_exact = true;
+        if (swapped) {   // the iterate into p, where polish_friction reads it
+          p.swap(pnew);
+          pc = p.data();
+          pq = pnew.data();
+          swapped = false;
+        }
+        if (polish_friction(law, true)) {
+          converged = true;
+          break;
+        }
+      }
       // The velocity changes of the last sweep are not needed: recompute_dv() below.
       if (change <= stop * pm) {
         converged = true;
