@@ -861,6 +861,11 @@ class EventLoop {
   // forced to change; tried on frictionless pairs too, the 50-circle frictionless pile at
   // e 0.9 (seed 3) crawled for minutes (1 s before: CorePileSettles ... n50_e9_seed3_mu0).
   bool stopped_and_held(std::uint32_t i, std::uint32_t j, double t, double t_abs) {
+    // Only a free body striking one at rest can be so held (checked first: the dry run is a
+    // whole set solve).
+    const bool free_on_resting = (w_.stationary(j) && !w_.stationary(i) && !w_.supported(i)) ||
+                                 (w_.stationary(i) && !w_.stationary(j) && !w_.supported(j));
+    if (!free_on_resting) return false;
     w_.sim_trial.clear();
     w_.sim_dry_run = true;
     const bool solved = resolve_simultaneous(w_, i, j, t, set_, impacted_, 0.0);
