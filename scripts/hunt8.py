@@ -421,7 +421,7 @@ def gen_hugedt(out, truth, quick):
     r = 0.1
     for h in ([0.01] if quick else [0.01, 0.1]):
         tf = math.sqrt(2 * h / G0)
-        for mult in ([1.0, 200.0] if quick else [1.0, 30.0, 100.0, 150.0, 200.0, 400.0]):
+        for mult in ([1.0, 30.0] if quick else [1.0, 30.0, 100.0, 150.0, 200.0, 400.0]):
             dt = mult * tf
             T = 2 * dt + 0.37 * tf   # two steps and a short last one
             s = T % (2 * tf)
