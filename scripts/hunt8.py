@@ -14,6 +14,8 @@ Families:
   windfloor    a ball on a floor with friction under linear drag towards a wind that blows along
                the floor and up or down (the drag's normal part changes the normal force): held
                or sliding to its terminal speed, or lifted; the closed form of linear drag.
+  quadwind     the same under quadratic drag (the wind's up part presses less), against an RK4
+               integration at 1e-5 s.
   newtoncoll   two balls released at rest under Newtonian gravity (G = 1), and a ball above a
                static planet: radial infall, the impact at the closed-form time, then with e = 1
                back to rest at the start (periodic), with e < 1 each rebound lower (the closed
@@ -22,10 +24,19 @@ Families:
                of the fall, and at dt of several falls), masses 1e-6 to 1e9 kg, e 0, 0.5, 1: the
                bounces' closed form; core exact, every engine's position_divergence must see its
                miss.
+  hugedt       an elastic ball bouncing on a floor at steps of 1 to 400 of its falls (--quick: 1
+               and 30; from 150 the reference settles the bounce and converges to that: open).
+  sliver       a free ball and a bounce over a whole number of steps and a sliver (1e-7-0.5 of a
+               step): the reference must converge (before the eighth hunt the samples at the
+               last whole step and the end were paired across the two runs).
   boxcorner    a ball striking the corner of a solid box ([[boxes]]) 0.1-0.95 of its radius
                above it at 2-80 m/s, e 1 and 0.5, dt 1/60 and 1/30: the impact on the corner's
-               normal (the line from the corner to the centre at contact); a run whose ball went
-               on untouched (a skipped impact) must not be `ok`.
+               normal (the line from the corner to the centre at contact), also a thin post's
+               corner, a surface's tip and a wall's end; a run whose ball went on untouched,
+               apart from the barrier at both ends of the step it passed the corner in (a skipped
+               impact), must not be `ok`.
+  ledge        a ball sliding off a box, a surface or two walls (0.3-8 m/s): flying off, or
+               turning about the corner until the normal force is 0 (RK4), then flying.
 
 Every family: core (the reference engine, exact for piecewise-constant forces) must meet a
 closed form it can meet exactly to 1e-6 of the scene's size; the converged reference must meet
@@ -257,6 +268,62 @@ friction = {fmt(mu)}
 restitution = 0.0
 """)
                 truth[name] = dict(final={"b": (x, v)}, exact=False, scale=max(1.0, math.hypot(x[0], x[1] - r)), kind=kind)
+
+
+def quad_wind_floor(k2, m, w, mu, g, T):
+    """A ball on a floor under quadratic drag towards the wind w (its up part presses less):
+    (displacement, velocity) at T by RK4 at 1e-5 s, or None where it lifts off or is held."""
+    c = k2 / m
+    def acc(v):
+        rx, ry = w[0] - v, w[1]
+        q = math.hypot(rx, ry)
+        n = g - c * q * ry
+        return c * q * rx - math.copysign(mu * n, v if v != 0 else rx), n
+    a0, n0 = acc(0.0)
+    if n0 <= 0 or abs(c * math.hypot(*w) * w[0]) <= mu * n0:
+        return None
+    x, v, h = 0.0, 0.0, 1e-5
+    for _ in range(int(round(T / h))):
+        k1x, k1v = v, acc(v)[0]
+        k2x, k2v = v + h / 2 * k1v, acc(v + h / 2 * k1v)[0]
+        k3x, k3v = v + h / 2 * k2v, acc(v + h / 2 * k2v)[0]
+        k4x, k4v = v + h * k3v, acc(v + h * k3v)[0]
+        x += h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x)
+        v += h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)
+    return x, v
+
+
+def gen_quadwind(out, truth, quick):
+    r, T, m = 0.2, 2.0, 1.0
+    for k2 in ([0.1] if quick else [0.02, 0.1, 0.4]):
+        for w in ([(10.0, 5.0)] if quick else [(10.0, 0.0), (10.0, 5.0), (10.0, -8.0), (20.0, 10.0)]):
+            for mu in ([0.3] if quick else [0.0, 0.3]):
+                res = quad_wind_floor(k2, m, w, mu, G0, T)
+                if res is None:
+                    continue
+                dx, vx = res
+                name = f"qwind_k{ident(k2)}_w{ident(w[0])}_{ident(w[1])}_mu{ident(mu)}"
+                write(out, name, f"""name = "{name}"
+duration = {fmt(T)}
+[world]
+gravity = [0.0, {fmt(-G0)}]
+wind = {vec(w)}
+[[bodies]]
+name = "b"
+radius = {fmt(r)}
+mass = {fmt(m)}
+position = [0.0, {fmt(r)}]
+friction = {fmt(mu)}
+restitution = 0.0
+drag_quadratic = {fmt(k2)}
+[[walls]]
+name = "floor"
+from = [-300.0, 0.0]
+to = [300.0, 0.0]
+friction = {fmt(mu)}
+restitution = 0.0
+""")
+                truth[name] = dict(final={"b": ((dx, r), (vx, 0.0))}, exact=False, scale=max(1.0, dx))
 
 
 # ---------------------------------------------------------------- newtoncoll
@@ -664,7 +731,7 @@ def judge(name, t, runs, ref, out, find):
         NOTES.append(f"{name}: reference not converged: {str(ref.get('reason', ''))[:100]}")
 
 
-FAMILIES = {"thrustfloor": gen_thrustfloor, "thrustslope": gen_thrustslope, "windfloor": gen_windfloor, "newtoncoll": gen_newtoncoll,
+FAMILIES = {"thrustfloor": gen_thrustfloor, "thrustslope": gen_thrustslope, "windfloor": gen_windfloor, "quadwind": gen_quadwind, "newtoncoll": gen_newtoncoll,
             "scale": gen_scale, "hugedt": gen_hugedt, "sliver": gen_sliver, "boxcorner": gen_boxcorner, "ledge": gen_ledge}
 
 
