@@ -60,7 +60,10 @@ class ContainmentMonitor {
     double radius = 0.0;   // circles
     std::size_t group = 0;   // index into barrier groups
     std::size_t body = static_cast<std::size_t>(-1);   // a static body's index
-    std::size_t wall = static_cast<std::size_t>(-1);   // a wall's index in scene.walls
+    // A segment's barrier: its index among the walls, then the boxes, then the surfaces
+  // (scene.walls.size() + k for box k, and past those for surface k): a skipped impact names
+  // it to the comparator, past the bodies.
+  std::size_t owner = static_cast<std::size_t>(-1);
     std::string what;      // "wall 'left'"
   };
   void candidates(Vec2 lo, Vec2 hi);

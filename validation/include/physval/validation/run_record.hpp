@@ -115,7 +115,7 @@ struct ContainmentRecord {
   // step either side): the engine skipped an impact the reference makes (README
   // "Metrics", escaped_bodies). At most kMaxGrazes are kept (the first ones).
   struct Graze {
-    std::uint32_t a = 0, b = 0;   // scene body indices
+    std::uint32_t a = 0, b = 0;   // scene body indices; b past the bodies: a wall, box or surface (containment.hpp)
     double time = 0.0;            // s, the end of the step
     double step = 0.0;            // s, its length
     double depth = 0.0;           // m, the straight relative path's deepest overlap
