@@ -584,8 +584,7 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
       // skipped impact when the converged reference has a contact of this pair in this step
       // (the seventh hunt's glancing miss, 0.4 of the radius deep, was `ok`). A gas whose
       // trajectories left the reference's is not judged on contacts that no longer match.
-      if (!into_each_other && h > 0.0 && record_.grazes.size() < ContainmentRecord::kMaxGrazes &&
-          std::min(ri, rj) > 0.0) {
+      if (!into_each_other && h > 0.0 && std::min(ri, rj) > 0.0) {
         const Vec2 d0 = before(i) - before(j);
         const double slop = ContainmentRecord::kGrazeSlop * std::min(ri, rj);
         // Past the closest approach at the end (u <= 1: separating or tangent there) and
@@ -605,8 +604,8 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
           if (along < limit && closest_at <= 1.0 + 1e-9 && u > 0.0) {
             const double off = straight_either(i) + straight_either(j);
             if (off < 0.25 * slop && along + off < limit) {
-              record_.grazes.push_back({static_cast<std::uint32_t>(std::min(i, j)), static_cast<std::uint32_t>(std::max(i, j)),
-                                        t, h, ri + rj - along});
+              keep_graze({static_cast<std::uint32_t>(std::min(i, j)), static_cast<std::uint32_t>(std::max(i, j)),
+                          t, h, ri + rj - along});
             }
           }
         }
@@ -706,8 +705,7 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
       // (A straight path's distance to a line is linear: between its ends it comes closer
       // to a segment only near an end point, or by crossing it, an escape above.)
       if (!through && i < nb && r > 0.0 && h > 0.0 && previous_alive_[i] &&
-          (b.circle ? b.body < scene_.bodies.size() : b.wall < scene_.walls.size()) &&
-          record_.grazes.size() < ContainmentRecord::kMaxGrazes) {
+          (b.circle ? b.body < scene_.bodies.size() : b.wall < scene_.walls.size())) {
         const double slop = ContainmentRecord::kGrazeSlop * r;
         const double reach = b.circle ? r + b.radius : r;
         auto overlap = [&](Vec2 q) {
@@ -736,8 +734,7 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
             const double off = straight_either(i);
             if (off < 0.25 * slop && along + off < limit) {
               const std::size_t other = b.circle ? b.body : scene_.bodies.size() + b.wall;
-              record_.grazes.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(other), t, h,
-                                        reach - along});
+              keep_graze({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(other), t, h, reach - along});
               break;
             }
           }
