@@ -8,7 +8,8 @@
 #   scripts/overhead.sh [--all] [--physval PATH] [--keep DIR] [PATH...] [-- physval options]
 #
 # -j 1 so that each figure is one process's own; run it on an idle machine (the load
-# average is printed before and after). Needs python3.
+# average is printed before and after). The output goes to a folder made by mktemp
+# (TMPDIR=/dev/shm puts it on tmpfs). Needs python3.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 physval="$here/build/physval"
@@ -29,6 +30,10 @@ done
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
+# The series and scene files are created here (TMPDIR, else /tmp): their creation is part of
+# the harness's CPU, and on an ext4 without a journal it depends on how many files were
+# deleted there in the last minutes (README "Harness overhead", ninth pass).
+echo "output folder: $work ($(stat -f -c %T "$work" 2>/dev/null || echo unknown))"
 status=0
 "$physval" run "${paths[@]}" -j 1 --quiet --out "$work/out" --overhead "$work/overhead.json" "${extra[@]}" || status=$?
 echo "load average after:  $(cut -d' ' -f1-3 /proc/loadavg)"
