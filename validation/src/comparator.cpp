@@ -878,6 +878,27 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
                    fmt(c.first_escape_time.value_or(0.0)) + " s)" + then;
       judge_known_divergence(run, scene, "escaped_bodies", *c.escaped_bodies, "");
     }
+    // Passes found past the kept ones (ContainmentRecord::kMaxGrazes) were not judged: with
+    // a converged reference to judge them against, one of them may be a skipped impact
+    // (10,000 passes of a gas that left the reference's trajectories, then one through a
+    // static body the reference meets, was `ok`). Such a run is not ok, and a count of
+    // escapes is no more than a lower bound (a known failure's count cannot accept it).
+    if (run.containment.grazes_dropped > 0 && c.escaped_bodies && reference.available && reference.converged &&
+        reference.run) {
+      const std::string dropped = std::to_string(run.containment.grazes_dropped) + " straight passes through other bodies "
+                                  "or walls (grazes) beyond the " + std::to_string(ContainmentRecord::kMaxGrazes) +
+                                  " kept were not judged against the reference's contacts (first in the step to t = " +
+                                  fmt(run.containment.first_dropped_graze_time.value_or(0.0)) +
+                                  " s): a skipped impact among them cannot be ruled out";
+      if (run.status == RunStatus::Ok) {
+        run.status = RunStatus::Diverged;
+        run.diverged_at = run.containment.first_dropped_graze_time;
+        run.reason = dropped;
+      } else if (run.known_divergence) {
+        run.known_divergence = false;
+        run.reason += "; not accepted as known: " + dropped;
+      }
+    }
   }
 
   // core in exact mode guarantees that nothing overlaps (impacts at their exact times,

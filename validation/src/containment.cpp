@@ -587,8 +587,7 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
       // skipped impact when the converged reference has a contact of this pair in this step
       // (the seventh hunt's glancing miss, 0.4 of the radius deep, was `ok`). A gas whose
       // trajectories left the reference's is not judged on contacts that no longer match.
-      if (!into_each_other && h > 0.0 && record_.grazes.size() < ContainmentRecord::kMaxGrazes &&
-          std::min(ri, rj) > 0.0) {
+      if (!into_each_other && h > 0.0 && std::min(ri, rj) > 0.0) {
         const Vec2 d0 = before(i) - before(j);
         const double slop = ContainmentRecord::kGrazeSlop * std::min(ri, rj);
         // Past the closest approach at the end (u <= 1: separating or tangent there) and
@@ -608,8 +607,8 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
           if (along < limit && closest_at <= 1.0 + 1e-9 && u > 0.0) {
             const double off = straight_either(i) + straight_either(j);
             if (off < 0.25 * slop && along + off < limit) {
-              record_.grazes.push_back({static_cast<std::uint32_t>(std::min(i, j)), static_cast<std::uint32_t>(std::max(i, j)),
-                                        t, h, ri + rj - along});
+              keep_graze({static_cast<std::uint32_t>(std::min(i, j)), static_cast<std::uint32_t>(std::max(i, j)),
+                          t, h, ri + rj - along});
             }
           }
         }
@@ -713,8 +712,7 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
       // (A straight path's distance to a line is linear: between its ends it comes closer
       // to a segment only near an end point, or by crossing it, an escape above.)
       if (!through && i < nb && r > 0.0 && h > 0.0 && previous_alive_[i] &&
-          (b.circle ? b.body < scene_.bodies.size() : b.owner != static_cast<std::size_t>(-1)) &&
-          record_.grazes.size() < ContainmentRecord::kMaxGrazes) {
+          (b.circle ? b.body < scene_.bodies.size() : b.owner != static_cast<std::size_t>(-1))) {
         const double slop = ContainmentRecord::kGrazeSlop * r;
         const double reach = b.circle ? r + b.radius : r;
         auto overlap = [&](Vec2 q) {
@@ -748,13 +746,12 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
             if (off < 0.25 * slop && along + off < limit) {
               const std::size_t other = b.circle ? b.body : scene_.bodies.size() + b.owner;
               // One record a step for a barrier: a box's corner ends two of its sides (the
-              // deeper one kept).
+              // deeper one kept). Past the cap a corner's second side counts as dropped too.
               ContainmentRecord::Graze* last = record_.grazes.empty() ? nullptr : &record_.grazes.back();
               if (last && last->a == i && last->b == other && last->time == t) {
                 last->depth = std::max(last->depth, reach - along);
               } else {
-                record_.grazes.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(other), t, h,
-                                          reach - along});
+                keep_graze({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(other), t, h, reach - along});
               }
               break;
             }

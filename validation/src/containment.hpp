@@ -72,6 +72,15 @@ class ContainmentMonitor {
   // A particle's parent (none for a scene body: -1, matching no barrier's body).
   std::size_t parent_of(std::size_t i) const { return i < parent_.size() ? parent_[i] : static_cast<std::size_t>(-1); }
   void penetration(double depth, double t, const std::string& what);
+  // A graze for the comparator: kept while fewer than ContainmentRecord::kMaxGrazes are,
+  // else counted as dropped (the comparator then does not let the run be ok on the kept).
+  void keep_graze(const ContainmentRecord::Graze& g) {
+    if (record_.grazes.size() < ContainmentRecord::kMaxGrazes) {
+      record_.grazes.push_back(g);
+      return;
+    }
+    if (record_.grazes_dropped++ == 0) record_.first_dropped_graze_time = g.time;
+  }
 
   const Scene& scene_;
   std::vector<Barrier> barriers_;
