@@ -39,13 +39,17 @@
 #   hunt7     scripts/hunt7.py --quick (the seventh hunt's families, small grids): particles in a
 #             closed box in core's exact and lecture modes, grazes across the escape rule's
 #             half radius, long runs and step limits, mass ratios touching at t = 0
+#   hunt8     scripts/hunt8.py --quick (the eighth hunt's families, small grids): thrust and wind
+#             with friction on a floor (the normal force from the thrust or the drag), radial
+#             infall under Newtonian gravity with impacts, drops at radii 1e-4-1e4 m, passes
+#             by a box's corner, a surface's tip or a wall's end, balls off a ledge
 set -euo pipefail
 build=build
 jobs=$(nproc)
 while (($#)); do
   case "$1" in
     -j) jobs="$2"; shift 2 ;;
-    -h|--help) sed -n 2,38p "$0"; exit 0 ;;
+    -h|--help) sed -n 2,42p "$0"; exit 0 ;;
     *) build="$1"; shift ;;
   esac
 done
@@ -1016,4 +1020,9 @@ python3 "$(dirname "$0")/hunt7.py" "$build" "$work/hunt7" --quick -j "$jobs" | g
 found7=${PIPESTATUS[0]}
 set -e
 [ "$found7" -le 1 ] || exit 2
-exit $((found | found6 | found7 | bad))
+set +e
+python3 "$(dirname "$0")/hunt8.py" "$build" "$work/hunt8" --quick -j "$jobs" | grep -v '^note '
+found8=${PIPESTATUS[0]}
+set -e
+[ "$found8" -le 1 ] || exit 2
+exit $((found | found6 | found7 | found8 | bad))

@@ -60,7 +60,10 @@ class ContainmentMonitor {
     double radius = 0.0;   // circles
     std::size_t group = 0;   // index into barrier groups
     std::size_t body = static_cast<std::size_t>(-1);   // a static body's index
-    std::size_t wall = static_cast<std::size_t>(-1);   // a wall's index in scene.walls
+    // A segment's barrier: its index among the walls, then the boxes, then the surfaces
+  // (scene.walls.size() + k for box k, and past those for surface k): a skipped impact names
+  // it to the comparator, past the bodies.
+  std::size_t owner = static_cast<std::size_t>(-1);
     std::string what;      // "wall 'left'"
   };
   void candidates(Vec2 lo, Vec2 hi);
@@ -69,6 +72,15 @@ class ContainmentMonitor {
   // A particle's parent (none for a scene body: -1, matching no barrier's body).
   std::size_t parent_of(std::size_t i) const { return i < parent_.size() ? parent_[i] : static_cast<std::size_t>(-1); }
   void penetration(double depth, double t, const std::string& what);
+  // A graze for the comparator: kept while fewer than ContainmentRecord::kMaxGrazes are,
+  // else counted as dropped (the comparator then does not let the run be ok on the kept).
+  void keep_graze(const ContainmentRecord::Graze& g) {
+    if (record_.grazes.size() < ContainmentRecord::kMaxGrazes) {
+      record_.grazes.push_back(g);
+      return;
+    }
+    if (record_.grazes_dropped++ == 0) record_.first_dropped_graze_time = g.time;
+  }
 
   const Scene& scene_;
   std::vector<Barrier> barriers_;

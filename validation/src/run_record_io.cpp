@@ -145,6 +145,8 @@ void write_record(Sink& sink, const RunRecord& r) {
     w.f64(g.step);
     w.f64(g.depth);
   }
+  w.u64(c.grazes_dropped);
+  w.opt(c.first_dropped_graze_time);
   w.u64(kMagic);
 }
 
@@ -444,6 +446,8 @@ RunRecord read_record(Source& source) {
     g.depth = rd.f64();
     c.grazes.push_back(g);
   }
+  c.grazes_dropped = rd.u64();
+  c.first_dropped_graze_time = rd.opt();
   if (rd.u64() != kMagic) throw std::runtime_error("run record: malformed (no end mark)");
   return r;
 }

@@ -11,6 +11,7 @@
 
 #include "../src/containment.hpp"
 #include "physval/validation/comparator.hpp"
+#include "physval/validation/run_record_io.hpp"
 #include "physval_command.hpp"
 
 namespace physval {
@@ -547,6 +548,74 @@ TEST(Hunt7Containment, ASkippedImpactOnAStaticIsKeptForTheComparator) {
   EXPECT_EQ(m.record().grazes[0].a, 0u);
   EXPECT_EQ(m.record().grazes[0].b, 1u);
   EXPECT_NEAR(m.record().grazes[0].depth, 0.2, 1e-12);
+}
+
+
+// review9: at most ContainmentRecord::kMaxGrazes passes are kept. Before, the monitor
+// stopped looking once it held that many, so a skipped impact after 10,000 passes the
+// reference does not confirm (a gas that left its trajectories) was never judged: `ok`.
+// Now the passes past the cap are counted (and written with the record), and a run with
+// such passes and a converged reference is not ok on the kept ones alone.
+TEST(Hunt7Containment, PassesBeyondTheKeptOnesAreNotASilentOk) {
+  const double h = 1.0 / 30.0;
+  Scene s = two_balls("graze", h);
+  const std::size_t cap = ContainmentRecord::kMaxGrazes;
+  // a passes b (at rest) 0.8 off, there and back at 80 m/s: one graze per step (0.2 m deep).
+  ContainmentMonitor m(s);
+  const Vec2 left{-1.4, 0.8}, right{-1.4 + 80.0 * h, 0.8};
+  m.start({at(left, {80.0, 0.0}), at({0.0, 0.0}, {0.0, 0.0})});
+  const std::size_t steps = cap + 3;
+  for (std::size_t k = 1; k <= steps; ++k) {
+    const bool odd = k % 2 == 1;
+    m.observe(static_cast<double>(k) * h, {at(odd ? right : left, {odd ? 80.0 : -80.0, 0.0}), at({0.0, 0.0}, {0.0, 0.0})});
+  }
+  ASSERT_EQ(m.record().grazes.size(), cap);
+  EXPECT_EQ(m.record().grazes_dropped, 3u);
+  ASSERT_TRUE(m.record().first_dropped_graze_time);
+  EXPECT_DOUBLE_EQ(*m.record().first_dropped_graze_time, static_cast<double>(cap + 1) * h);
+  // Written with the record and read back.
+  RunRecord written;
+  written.containment = m.record();
+  const RunRecord back = decode_run_record(encode_run_record(written));
+  EXPECT_EQ(back.containment.grazes.size(), cap);
+  EXPECT_EQ(back.containment.grazes_dropped, 3u);
+  EXPECT_EQ(back.containment.first_dropped_graze_time, written.containment.first_dropped_graze_time);
+
+  // The comparator: the kept passes have no contact of the reference near them; the
+  // reference has one contact only, in the steps of the dropped ones (further than a step
+  // from the last kept one).
+  s.duration = static_cast<double>(steps + 1) * h;
+  auto judged = [&](std::uint64_t dropped, const std::string& known = "") {
+    Scene scene = s;
+    if (!known.empty()) scene.gate.known_failures["bullet"]["escaped_bodies"] = 2.0;
+    RunRecord run;
+    run.engine = "bullet";
+    run.dt = h;
+    run.containment = m.record();
+    run.containment.grazes_dropped = dropped;
+    if (dropped == 0) run.containment.first_dropped_graze_time.reset();
+    Reference ref;
+    ref.available = true;
+    ref.converged = true;
+    ref.dt = h / 8;
+    ref.run = RunRecord{};
+    ref.run->contacts.push_back({"a", "b", (static_cast<double>(cap) + 2.5) * h, 1});
+    if (!known.empty()) ref.run->contacts.push_back({"a", "b", 1.5 * h, 1});   // the first kept pass too
+    compare_run(run, scene, ref, false);
+    return run;
+  };
+  EXPECT_EQ(judged(0).status, RunStatus::Ok);   // no pass beyond the kept ones: judged whole
+  const RunRecord over = judged(3);
+  EXPECT_EQ(over.status, RunStatus::Diverged) << over.reason;
+  EXPECT_NE(over.reason.find("not judged"), std::string::npos) << over.reason;
+  ASSERT_TRUE(over.diverged_at);
+  EXPECT_DOUBLE_EQ(*over.diverged_at, static_cast<double>(cap + 1) * h);
+  // A counted skip within a known failure's count: the count is a lower bound, not accepted.
+  const RunRecord known0 = judged(0, "known"), known3 = judged(3, "known");
+  EXPECT_EQ(known0.status, RunStatus::Diverged) << known0.reason;
+  EXPECT_TRUE(known0.known_divergence) << known0.reason;
+  EXPECT_EQ(known3.status, RunStatus::Diverged) << known3.reason;
+  EXPECT_FALSE(known3.known_divergence) << known3.reason;
 }
 
 }  // namespace

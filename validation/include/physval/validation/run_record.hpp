@@ -113,9 +113,12 @@ struct ContainmentRecord {
   // than a slop of kGrazeSlop x the smaller radius). The comparator calls such a pass an
   // escape when the converged reference has a contact of that pair in that step (within a
   // step either side): the engine skipped an impact the reference makes (README
-  // "Metrics", escaped_bodies). At most kMaxGrazes are kept (the first ones).
+  // "Metrics", escaped_bodies). At most kMaxGrazes are kept (the first ones); the passes
+  // found past them are counted in grazes_dropped (with the first one's time), and the
+  // comparator does not let such a run be ok on the kept ones alone (a skipped impact among
+  // the dropped ones could not be judged).
   struct Graze {
-    std::uint32_t a = 0, b = 0;   // scene body indices
+    std::uint32_t a = 0, b = 0;   // scene body indices; b past the bodies: a wall, box or surface (containment.hpp)
     double time = 0.0;            // s, the end of the step
     double step = 0.0;            // s, its length
     double depth = 0.0;           // m, the straight relative path's deepest overlap
@@ -123,6 +126,8 @@ struct ContainmentRecord {
   static constexpr double kGrazeSlop = 0.02;
   static constexpr std::size_t kMaxGrazes = 10000;
   std::vector<Graze> grazes;
+  std::uint64_t grazes_dropped = 0;                 // found past kMaxGrazes, not kept
+  std::optional<double> first_dropped_graze_time;   // s, the end of that one's step
   // Set by the comparator (not written anywhere): the escapes it judged, the record's and
   // the skipped impacts together (the run's escaped_bodies metric), and the first's time.
   std::optional<int> judged_escaped_bodies;
