@@ -712,7 +712,9 @@ class EventLoop {
     PairMaterial m = w_.pair_material(w_.material[i], w_.material[j]);
     // Inelastic collapse: below the collapse speed an impact is perfectly inelastic (for
     // a pair whose cluster rests on something; a freely falling one keeps e).
-    const bool slow = collapses(w_, i, j, t, -dot(w_.vel[j] - w_.vel[i], n));
+    // An elastic pair (e = 1) never collapses (impact_rest_speed).
+    const double e0 = m.restitution;
+    const bool slow = e0 < 1.0 && collapses(w_, i, j, t, -dot(w_.vel[j] - w_.vel[i], n));
     if (slow) m.restitution = 0.0;
     double min_sep = 0.0;
     bool settled = false;
@@ -721,7 +723,7 @@ class EventLoop {
       const double an = dot(w_.effective_acc(j) - w_.effective_acc(i), n);
       const double vn = dot(w_.vel[j] - w_.vel[i], n);
       if (an < 0.0) {
-        const double vr = w_.rest_speed(an, ctx_.dt);
+        const double vr = w_.impact_rest_speed(an, ctx_.dt, e0, vn);
         closing = -vn;
         rest_vr = vr;
         if (m.restitution * std::max(0.0, -vn) < vr) {
@@ -995,7 +997,7 @@ class EventLoop {
     const double vn = dot(w_.vel[i], n);
     const double an = dot(w_.effective_acc(i), n);
     const bool pressed = w_.any_forces && an < 0.0;
-    const double vr = pressed ? w_.rest_speed(an, ctx_.dt) : 0.0;
+    const double vr = pressed ? w_.impact_rest_speed(an, ctx_.dt, m.restitution, vn) : 0.0;
     const bool slow = pressed && m.restitution * std::max(0.0, -vn) < vr;
     const bool own_support = w_.supported(i) && w_.support[i] == k;
     // A gas's wall impact with nothing else near: the pairwise response, its new path's

@@ -1656,7 +1656,10 @@ void detect_support(World& w, std::uint32_t i, const StepContext& ctx) {
     // Moving off the face only beyond the round-off of its velocity's components (a ball
     // launched at 3 m/s along a 5 degree slope read v.n = +1e-16 and was left free, met the
     // face and its neighbour as impacts at once, and never became a train).
-    if (vn > 64.0 * 2.220446049250313e-16 * length(w.vel[i]) || -vn > w.rest_speed(an, ctx.dt)) continue;
+    // Moving into it: settled below the rest speed, an elastic face (e = 1) only at
+    // round-off (World::impact_rest_speed: it bounces).
+    const double e = w.pair_material(w.material[i], s.material).restitution;
+    if (vn > 64.0 * 2.220446049250313e-16 * length(w.vel[i]) || -vn > w.impact_rest_speed(an, ctx.dt, e, vn)) continue;
     w.support[i] = k;
     w.support_n[i] = n;
     record_contact(w, i, kNone, &s, ctx.t0, ctx.dt);

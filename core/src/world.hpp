@@ -366,6 +366,17 @@ struct World {
   double rest_speed(double a_n, double dt) const {
     return rest_speed_option > 0.0 ? rest_speed_option : rest_factor * std::abs(a_n) * dt;
   }
+  // The rest speed of an impact whose restitution is e, the normal speed v_n, pressed with
+  // a_n. An elastic impact (e >= 1) cannot collapse (its bounces do not shorten: a ball
+  // dropped on a floor at e = 1 is periodic at any step): with the automatic rest speed it
+  // settles only a normal speed at round-off of |v_n| and |a_n| dt (the zero-time impacts of
+  // a body resting with a speed of 1e-16 m/s), not one below |a_n| dt / 16 (hugedt).
+  double impact_rest_speed(double a_n, double dt, double e, double v_n) const {
+    if (e >= 1.0 && !(rest_speed_option > 0.0)) {
+      return 64.0 * 2.220446049250313e-16 * (std::abs(v_n) + std::abs(a_n) * dt);
+    }
+    return rest_speed(a_n, dt);
+  }
   // Inelastic collapse: an impact of bodies i and j closing slower than this is
   // perfectly inelastic (restitution falls to 0): the rest speed of the larger of their
   // accelerations. 0 in a scene without forces. This is the speed for a pair whose
