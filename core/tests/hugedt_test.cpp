@@ -65,13 +65,12 @@ Off run(double h, double e, double falls, int steps) {
 }
 
 // e = 1 at steps of 0.3 to 400 falls (the reference's dt/8 and dt/4 of the hunt's 150-400):
-// (not yet: a step of more than 16 falls that ends exactly at an impact, where the step-start
-// hold (try_hold) still takes the ball, touching the floor below the rest speed, at rest)
+// and steps that end exactly at an impact (17, 151 falls; 18.75 x 4 = 37.5 x 2 = 75 falls).
 // the periodic closed form at every step's end. The tolerance is the round-off of a time of
 // ~k dt in the phase (k dt / tf bounces, each exact to round-off of its own time).
 TEST(CoreHugeDt, AnElasticBounceStaysPeriodicAtAnyStep) {
   for (double h : {0.01, 0.1, 1.0}) {
-    for (double falls : {0.3, 1.0, 7.0, 18.7, 30.0, 37.3, 100.0, 150.0, 400.0}) {
+    for (double falls : {0.3, 1.0, 7.0, 17.0, 18.7, 18.75, 30.0, 37.3, 37.5, 100.0, 150.0, 151.0, 400.0}) {
       const int steps = 5;
       const Off o = run(h, 1.0, falls, steps);
       const double bounces = steps * falls;
