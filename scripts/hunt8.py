@@ -25,7 +25,7 @@ Families:
                bounces' closed form; core exact, every engine's position_divergence must see its
                miss.
   hugedt       an elastic ball bouncing on a floor at steps of 1 to 400 of its falls (--quick: 1
-               and 30; from 150 the reference settles the bounce and converges to that: open).
+               and 30; from 150 the reference settled the bounce and converged to that, fixed on hugedt9).
   sliver       a free ball and a bounce over a whole number of steps and a sliver (1e-7-0.5 of a
                step): the reference must converge (before the eighth hunt the samples at the
                last whole step and the end were paired across the two runs).
