@@ -8,10 +8,16 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <iterator>
+#include <vector>
 #include <fstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
+#include "physval/engine/scene.hpp"
 #include "physval/validation/conservation.hpp"
 
 namespace {
@@ -123,6 +129,126 @@ TEST_F(ConservationRules, FrictionlessPairIsHeldToAngularMomentum) {
   const auto r = physval("gate " + write(scene_text("0.0", "angular_momentum_drift = 1e-12")).string() +
                          " --no-cache --out " + (dir_ / "out").string());
   EXPECT_EQ(r.status, 0) << r.output;
+}
+
+
+// Hunt 10: a restitution above 1 gains energy at every impact. Before, the rule took it for
+// elastic: energy "conserved" (every engine, core too, read drifts of 0.09-0.56 at e 1.05-1.5
+// in a ball bouncing on a floor) and "only lost" (a gain read as a blow-up).
+TEST(ConservationRulesUnit, RestitutionAboveOneIsNeitherConservedNorOnlyLost) {
+  physval::Scene s;
+  physval::BodyDef b;
+  b.name = "ball";
+  b.radius = 0.1;
+  b.position = {0.0, 1.1};
+  b.restitution = 1.2;
+  s.bodies.push_back(b);
+  s.world.gravity = {0.0, -9.8};
+  physval::WallDef w;
+  w.name = "floor";
+  w.from = {-5.0, 0.0};
+  w.to = {5.0, 0.0};
+  w.material.restitution = 1.2;
+  s.walls.push_back(w);
+  physval::Conserved c = physval::conserved_quantities(s);
+  EXPECT_FALSE(c.energy);
+  EXPECT_FALSE(c.energy_non_increasing);
+  EXPECT_EQ(c.energy_why, "restitution above 1");
+  // through a [[materials]] override alone
+  s.bodies[0].restitution = 1.0;
+  s.walls[0].material.restitution = 1.0;
+  EXPECT_TRUE(physval::conserved_quantities(s).energy);
+  s.materials.push_back(physval::MaterialOverride{"ball", "floor", 1.5, std::nullopt, std::nullopt, std::nullopt});
+  c = physval::conserved_quantities(s);
+  EXPECT_FALSE(c.energy);
+  EXPECT_FALSE(c.energy_non_increasing);
+  // static friction given only through an override is friction too
+  s.materials[0] = physval::MaterialOverride{"ball", "floor", std::nullopt, std::nullopt, 0.5, std::nullopt};
+  EXPECT_FALSE(physval::conserved_quantities(s).energy);
+}
+
+// Hunt 10: static friction above the pair's kinetic friction, given only through a
+// [[materials]] override, is the feature static_friction (which only core models). Before, it
+// was not one: Box2D, Bullet, Chipmunk and ODE ran such a pair with one coefficient, `ok`.
+TEST(ConservationRulesUnit, StaticFrictionFromAnOverrideIsAFeature) {
+  physval::Scene s;
+  physval::BodyDef b;
+  b.name = "ball";
+  b.radius = 0.1;
+  b.friction = b.static_friction = 0.2;
+  s.bodies.push_back(b);
+  physval::WallDef w;
+  w.name = "slope";
+  w.from = {-5.0, -1.0};
+  w.to = {5.0, 1.0};
+  w.material.friction = w.material.static_friction = 0.2;
+  s.walls.push_back(w);
+  auto has = [&](physval::Feature f) {
+    const std::vector<physval::Feature> fs = physval::scene_features(s);
+    return std::find(fs.begin(), fs.end(), f) != fs.end();
+  };
+  EXPECT_FALSE(has(physval::Feature::StaticFriction));
+  s.materials.push_back(physval::MaterialOverride{"ball", "slope", std::nullopt, std::nullopt, 0.7, std::nullopt});
+  EXPECT_TRUE(has(physval::Feature::StaticFriction));
+  s.materials[0].friction = 0.7;   // mu_s = mu_k: one coefficient
+  EXPECT_FALSE(has(physval::Feature::StaticFriction));
+  // an override of the kinetic friction alone keeps the pair's static friction (the rule's
+  // max(mu_s, friction)): `friction = 0.0` between rough materials leaves mu_s 0.2 > mu_k 0
+  s.materials[0] = physval::MaterialOverride{"ball", "slope", std::nullopt, 0.0, std::nullopt, std::nullopt};
+  EXPECT_TRUE(has(physval::Feature::StaticFriction));
+  s.materials[0].friction = 0.3;   // raised: mu_s = max(0.2, 0.3) = mu_k
+  EXPECT_FALSE(has(physval::Feature::StaticFriction));
+  // rolling friction and friction given only by an override are features too
+  s.bodies[0].friction = s.bodies[0].static_friction = 0.0;
+  s.walls[0].material.friction = s.walls[0].material.static_friction = 0.0;
+  s.materials[0] = physval::MaterialOverride{"ball", "slope", std::nullopt, std::nullopt, std::nullopt, 0.05};
+  EXPECT_TRUE(has(physval::Feature::RollingFriction));
+  EXPECT_FALSE(has(physval::Feature::StaticFriction));
+}
+
+// End to end: the held ball of hunt10.py's matstatic family is unsupported on every engine
+// that cannot model static friction, and core holds it.
+TEST_F(ConservationRules, AnOverridesStaticFrictionIsNotRunOnEnginesWithOneCoefficient) {
+  const std::string scene = R"(name = "matstatic"
+duration = 1.0
+dt = "1/120"
+[world]
+gravity = [0.0, -9.8]
+[[bodies]]
+name = "ball"
+radius = 0.1
+position = [-0.04794255386042030, 0.08775825618903728]
+restitution = 0.0
+friction = 0.2
+[[walls]]
+name = "slope"
+from = [-17.551651237807455, -9.588510772084060]
+to = [17.551651237807455, 9.588510772084060]
+restitution = 0.0
+friction = 0.2
+[[materials]]
+a = "ball"
+b = "slope"
+static_friction = 0.8463024898437905
+[expect]
+final = [ { body = "ball", position = [-0.04794255386042030, 0.08775825618903728], tolerance = 1e-9 } ]
+)";
+  const fs::path out = dir_ / "out";
+  const auto r = physval("run " + write(scene).string() + " --no-cache --quiet --out " + out.string());
+  EXPECT_EQ(r.status, 0) << r.output;
+  std::ifstream in(out / "results.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  int unsupported = 0;
+  for (const nlohmann::json& run : j["runs"]) {
+    const std::string engine = run["engine"];
+    if (engine == "core") {
+      EXPECT_EQ(run["status"], "ok");
+    } else {
+      EXPECT_EQ(run["status"], "unsupported") << engine;
+      ++unsupported;
+    }
+  }
+  EXPECT_GE(unsupported, 2);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 
 namespace physval {
 
@@ -148,6 +149,28 @@ std::vector<Feature> scene_features(const Scene& scene) {
   const bool drag = used[static_cast<int>(Feature::LinearDrag)] || used[static_cast<int>(Feature::QuadraticDrag)];
   if (drag && (scene.world.wind.x != 0.0 || scene.world.wind.y != 0.0)) use(Feature::Wind);
   if (!scene.materials.empty()) use(Feature::MaterialOverrides);
+  // A [[materials]] override is a pair's material too: the pair's combined coefficients are
+  // features (before the tenth hunt an override static_friction = 0.85 over a pair of kinetic
+  // 0.2 ran on Box2D, Bullet, Chipmunk and ODE, which model one coefficient, as `ok`: a ball
+  // core held on a 0.5 rad slope slid 1.5 m there).
+  for (const MaterialOverride& o : scene.materials) {
+    const auto view = [&](const std::string& name) -> std::optional<MaterialView> {
+      for (const BodyDef& b : scene.bodies) if (b.name == name) return material_of(b);
+      for (const WallDef& w : scene.walls) if (w.name == name) return material_of(w.name, w.material);
+      for (const BoxDef& w : scene.boxes) if (w.name == name) return material_of(w.name, w.material);
+      for (const SurfaceDef& w : scene.surfaces) if (w.name == name) return material_of(w.name, w.material);
+      return std::nullopt;
+    };
+    const std::optional<MaterialView> a = view(o.a), b = view(o.b);
+    if (!a || !b) continue;
+    const PairMaterial pm = combine_materials(scene, *a, *b);
+    if (pm.friction > 0.0 || pm.static_friction > 0.0) use(Feature::Friction);
+    // also an override that lowers only the kinetic friction (`friction = 0.0` between rough
+    // bodies): the pair keeps its static friction (combine_materials), so core holds it at rest
+    // while an engine with one coefficient lets it slide
+    if (pm.static_friction > pm.friction) use(Feature::StaticFriction);
+    if (pm.rolling_friction > 0.0) use(Feature::RollingFriction);
+  }
   if (!scene.collision_matrix.empty()) use(Feature::CollisionMatrix);
   if (!scene.emitters.empty()) use(Feature::Particles);
   std::vector<Feature> out;
