@@ -26,6 +26,8 @@ Families:
   faroff       a bounce and a head-on pair moved up to 1e7 m from the origin, negative too, on
                core's broad phases: the same closed forms.
 
+`--quick` runs small grids of every family but impactstick (open, below); scripts/hunt.sh runs it.
+
 Every family: a converged reference must meet the closed form within ten times its convergence
 error; no engine may be `ok` with its position_divergence below half its miss of the closed
 form (a miss above 2% of the size); a core run in a family it is exact in must meet the closed
@@ -541,10 +543,11 @@ def judge_extra(name, t, runs, ref, out, find, conserve_rule):
 FAMILIES = {"orbitgraze": gen_orbitgraze, "soft": gen_soft, "superelastic": gen_superelastic,
             "matstatic": gen_matstatic, "matzero": gen_matzero, "impactstick": gen_impactstick,
             "faroff": gen_faroff}
+OPEN = {"impactstick"}
 
 
 def main(argv):
-    build, work, fams, jobs, quick = "build", "/tmp/hunt10", list(FAMILIES), 2, False
+    build, work, fams, jobs, quick = "build", "/tmp/hunt10", None, 2, False
     pos = []
     i = 0
     while i < len(argv):
@@ -564,6 +567,8 @@ def main(argv):
         else:
             pos.append(a)
         i += 1
+    if fams is None:   # --quick leaves out impactstick: core's impact law there is an open finding
+        fams = [f for f in FAMILIES if not (quick and f in OPEN)]
     if pos:
         build = pos[0]
     if len(pos) > 1:

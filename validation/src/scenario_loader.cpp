@@ -788,6 +788,27 @@ void check_references(Context& ctx, const toml::table& root, Scene& s) {
                                         "no body or barrier named \"" + *n + "\"");
     }
   }
+  // The pair's static friction must not fall below its kinetic friction (mu_s >= mu_k, as on a
+  // body): an override static_friction = 0.05 over rough bodies (mu 0.2) was accepted, a pair
+  // whose contact can slide but never stay at rest.
+  auto view_of = [&](const std::string& name) -> std::optional<MaterialView> {
+    for (const BodyDef& b : s.bodies) if (b.name == name) return material_of(b);
+    for (const WallDef& w : s.walls) if (w.name == name) return material_of(w.name, w.material);
+    for (const BoxDef& w : s.boxes) if (w.name == name) return material_of(w.name, w.material);
+    for (const SurfaceDef& w : s.surfaces) if (w.name == name) return material_of(w.name, w.material);
+    return std::nullopt;
+  };
+  for (std::size_t i = 0; i < s.materials.size(); ++i) {
+    if (!s.materials[i].static_friction) continue;
+    const std::optional<MaterialView> a = view_of(s.materials[i].a), b = view_of(s.materials[i].b);
+    if (!a || !b) continue;
+    const PairMaterial pm = combine_materials(s, *a, *b);
+    if (pm.static_friction < pm.friction) {
+      ctx.error(where("materials", i), indexed("materials", i) + ".static_friction",
+                "the pair's static friction " + format_number(pm.static_friction) + " is below its kinetic friction " +
+                    format_number(pm.friction) + " (mu_s >= mu_k); give the pair's friction too");
+    }
+  }
   for (std::size_t i = 0; i < s.emitters.size(); ++i) {
     if (!body_exists(s.emitters[i].parent)) {
       ctx.error(where("emitters", i), indexed("emitters", i) + ".parent", "no body named \"" + s.emitters[i].parent + "\"");

@@ -187,6 +187,23 @@ TEST(ScenarioLoader, StaticFrictionBelowKineticIsRejected) {
   expect_error(t, 5, "bodies[0].static_friction", "mu_s >= mu_k");
 }
 
+// Hunt 10: the same rule for a pair whose [[materials]] entry gives only static_friction (the
+// pair's kinetic friction is the materials' geometric mean, 0.5): accepted before.
+TEST(ScenarioLoader, AnOverridesStaticFrictionBelowThePairsKineticIsRejected) {
+  std::string t = kGood;
+  t.replace(t.find("mass = 2"), 8, "mass = 2\nfriction = 0.5");
+  t += "friction = 0.5\n[[materials]]\na = \"a\"\nb = \"floor\"\nstatic_friction = 0.1\n";
+  expect_error(t, 18, "materials[0].static_friction", "mu_s >= mu_k");
+  // at or above the pair's kinetic friction it is a valid pair
+  std::string ok = t;
+  ok.replace(ok.find("static_friction = 0.1"), 21, "static_friction = 0.5");
+  EXPECT_TRUE(parse_scenario(ok, "ok.toml").scene.has_value());
+  // and with the pair's kinetic friction given beside it
+  ok = t;
+  ok.replace(ok.find("static_friction = 0.1"), 21, "friction = 0.05\nstatic_friction = 0.1");
+  EXPECT_TRUE(parse_scenario(ok, "ok.toml").scene.has_value());
+}
+
 TEST(ScenarioLoader, CentreOfMassFromVertexMasses) {
   const ScenarioLoad load = parse_scenario(R"(name = "com"
 duration = 1.0
