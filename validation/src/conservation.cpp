@@ -68,21 +68,25 @@ Conserved conserved_quantities(const Scene& scene) {
   const bool has_barriers = !scene.walls.empty() || !scene.boxes.empty() || !scene.surfaces.empty() ||
                             std::any_of(scene.bodies.begin(), scene.bodies.end(), [](const BodyDef& b) { return b.is_static; });
   const bool field = scene.world.gravity.x != 0.0 || scene.world.gravity.y != 0.0;
-  // A restitution above 1 (a pinball bumper) gains energy at every impact: energy is then
-  // neither conserved nor only lost (before the tenth hunt e = 1.2 counted as elastic, and
-  // every engine, core too, read an energy drift of 0.27 in a scene held to conserve it).
+  // A pair whose restitution is above 1 (a pinball bumper) gains energy at every impact:
+  // energy is then neither conserved nor only lost (before the tenth hunt e = 1.2 counted as
+  // elastic, and every engine, core too, read an energy drift of 0.27 in a scene held to
+  // conserve it). A pair's restitution is the smaller of the two (or its override), so it
+  // takes two objects above 1 (bodies, or a body and a barrier), or an override above 1.
   bool drag = false, thrust = false, friction = false, inelastic = false, superelastic = false;
+  int bodies_above_one = 0;
+  bool barrier_above_one = false;
   for (const BodyDef& b : scene.bodies) {
     drag = drag || b.drag_linear > 0.0 || b.drag_quadratic > 0.0;
     thrust = thrust || b.thrust.enabled();
     friction = friction || b.friction > 0.0 || b.static_friction > 0.0 || b.rolling_friction > 0.0;
     inelastic = inelastic || b.restitution < 1.0;
-    superelastic = superelastic || b.restitution > 1.0;
+    if (b.restitution > 1.0) ++bodies_above_one;
   }
   auto static_material = [&](const StaticMaterial& m) {
     friction = friction || m.friction > 0.0 || m.static_friction > 0.0 || m.rolling_friction > 0.0;
     inelastic = inelastic || m.restitution < 1.0;
-    superelastic = superelastic || m.restitution > 1.0;
+    barrier_above_one = barrier_above_one || m.restitution > 1.0;
   };
   for (const WallDef& w : scene.walls) static_material(w.material);
   for (const BoxDef& w : scene.boxes) static_material(w.material);
@@ -93,6 +97,7 @@ Conserved conserved_quantities(const Scene& scene) {
     inelastic = inelastic || m.restitution.value_or(1.0) < 1.0;
     superelastic = superelastic || m.restitution.value_or(1.0) > 1.0;
   }
+  superelastic = superelastic || bodies_above_one >= 2 || (bodies_above_one >= 1 && barrier_above_one);
   const bool particles = !scene.emitters.empty();
   const bool destroys = std::any_of(scene.collision_matrix.begin(), scene.collision_matrix.end(), [](const CollisionRule& r) {
     return r.response == CollisionResponse::DestroyA || r.response == CollisionResponse::DestroyB ||

@@ -154,6 +154,12 @@ TEST(ConservationRulesUnit, RestitutionAboveOneIsNeitherConservedNorOnlyLost) {
   EXPECT_FALSE(c.energy);
   EXPECT_FALSE(c.energy_non_increasing);
   EXPECT_EQ(c.energy_why, "restitution above 1");
+  // one side above 1 is not enough: the pair's restitution is the smaller, 1 (energy conserved)
+  s.walls[0].material.restitution = 1.0;
+  EXPECT_TRUE(physval::conserved_quantities(s).energy);
+  s.walls[0].material.restitution = 1.2;
+  s.bodies[0].restitution = 1.0;
+  EXPECT_TRUE(physval::conserved_quantities(s).energy);
   // through a [[materials]] override alone
   s.bodies[0].restitution = 1.0;
   s.walls[0].material.restitution = 1.0;
