@@ -450,10 +450,10 @@ std::vector<double> convergence_limits(const Scene& scene, const Series& fine) {
 // (chaotic scenes, a gas, a pile: no verdict possible, conservation judges them as it
 // judges every engine there).
 void judge_against_own_reference(RunRecord& run, const Scene& scene, const Reference& reference) {
+  ReferenceCheck& rc = run.reference_check;
+  rc = ReferenceCheck{};   // a record compared again (or copied from another) keeps no stale verdict
   const EngineFactory* engine = reference_engine();
   if (engine == nullptr || run.engine != engine->info.name) return;
-  ReferenceCheck& rc = run.reference_check;
-  rc = ReferenceCheck{};
   rc.applies = true;
   auto setting = [&](const std::string& key) {
     for (const Setting& st : run.settings) {
@@ -735,6 +735,7 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
   const Reference& reference = reference_;
   run.metrics.clear();
   run.checks.clear();
+  run.reference_check = ReferenceCheck{};
   run.containment.judged_escaped_bodies = run.containment.escaped_bodies;
   run.containment.judged_first_escape_time = run.containment.first_escape_time;
   for (std::string_view name : kMetricNames) run.metrics[std::string(name)] = std::nullopt;
