@@ -95,7 +95,6 @@ TEST(OwnReference, CoreIsNeverOkWhereItMissesTheBounceClosedForm) {
       miss = std::max(miss, std::abs(y - bounce_height(c.h, c.e, j.run.series.time[k])));
     }
     const bool right = miss <= 1e-6 * c.h;
-    ASSERT_TRUE(j.run.reference_check.applies);
     if (j.run.status == RunStatus::Ok) {
       EXPECT_TRUE(right) << "core ok but " << miss << " m off the closed form: " << j.run.reference_check.note;
       EXPECT_TRUE(j.run.reference_check.judged) << j.run.reference_check.note;
