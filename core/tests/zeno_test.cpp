@@ -10,8 +10,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <sstream>
 
 #include "scene_fixture.hpp"
@@ -68,15 +66,15 @@ struct Case {
   double u0 = 0.0;     // the ball's speed along the face at release
 };
 
-// Runs the case at steps of `falls` falls (or `dt` when given) until the rest time and two
-// steps more (or max_steps); returns the largest miss at a step's end in position (relative
-// to the scene's size) and velocity (relative to its speeds), each over its tolerance.
 std::string describe(const Case& c) {
   std::ostringstream d;
   d << "h " << c.h << " e " << c.e << " dt " << c.falls << " falls tilt " << c.tilt << " u0 " << c.u0;
   return d.str();
 }
 
+// Runs the case at steps of `falls` falls (or `dt` when given) until the rest time and two
+// steps more (or max_steps); returns the largest miss at a step's end in position (relative
+// to the scene's size) and velocity (relative to its speeds), each over its tolerance.
 struct Miss {
   double pos = 0.0, vel = 0.0;
 };
@@ -109,9 +107,6 @@ Miss run(const Case& c, double dt = 0.0, int max_steps = 0) {
     const double dx = std::fabs(dot(q, dir) - x);
     const double vn = dot(v, n);
     const double dvn = z.flip ? std::min(std::fabs(vn - z.v_out), std::fabs(vn + z.v_in)) : std::fabs(vn - z.v);
-    if (const char* tr = std::getenv("ZENO_TRACE"); tr && describe(c).rfind(tr, 0) == 0) {
-      std::printf("k %d t %.17g y %.17g (%.17g) vn %.17g (%.17g) flip %d\n", k, t, dot(q, n) - r, z.y, vn, z.v, z.flip);
-    }
     const double dvx = std::fabs(dot(v, dir) - vx);
     // The tolerance (see kTol): the bounces before the tail are events, each impact's time a
     // root found to a few ulps of the time since the start; their errors add up (at most
@@ -127,8 +122,6 @@ Miss run(const Case& c, double dt = 0.0, int max_steps = 0) {
   }
   return worst;
 }
-
-
 
 // The grid: drops of 1 cm to 1 m, e 0.3 to 0.999, steps of 0.3 to 400 falls, every step's
 // end from the release to two steps past the rest (inside the tail, at rest after it).
