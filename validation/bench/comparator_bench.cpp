@@ -111,6 +111,40 @@ void BM_ScenarioComparisonsContactHeavy(benchmark::State& state) {
 }
 BENCHMARK(BM_ScenarioComparisonsContactHeavy)->Arg(10000)->Arg(30000)->Unit(benchmark::kMillisecond);
 
+// core's run held against its own converged reference (judge_against_own_reference): a
+// run of `range(0)` bodies and 100 samples under the reference engine's name, with settings
+// that claim exact paths (judged: one more pass over the samples, the per-body limits and
+// the pairing) or the lecture's collision pass (not judged: the check only reads the
+// settings). The ratio of the two is the check's cost in compare_run.
+void BM_CompareRunCoreOwnReference(benchmark::State& state) {
+  const auto bodies = static_cast<std::size_t>(state.range(0));
+  const bool judged = state.range(1) != 0;
+  Scene scene;
+  scene.name = "gas";
+  scene.dt = 1.0 / 240.0;
+  scene.duration = 4.0;
+  for (std::size_t i = 0; i < bodies; ++i) {
+    BodyDef b;
+    b.name = std::string("c").append(std::to_string(i));
+    b.radius = 0.05;
+    b.position = {static_cast<double>(i), 0.0};
+    scene.bodies.push_back(b);
+  }
+  Reference reference;
+  reference.available = reference.converged = true;
+  reference.dt = scene.dt / 8.0;
+  reference.run = gas_run("reference", bodies, 0, 100, 1);
+  RunRecord run = gas_run("core", bodies, 0, 100, 1);
+  run.settings = {{"integrator", "velocity_verlet"}, {"collision", judged ? "exact" : "lecture"}};
+  ScenarioComparer comparer(scene, reference);
+  for (auto _ : state) {
+    comparer.compare_run(run, false);   // clears and refills the run's verdict; the series stay
+    if (run.reference_check.judged != judged || run.status != RunStatus::Ok) state.SkipWithError("not as meant");
+    benchmark::DoNotOptimize(run);
+  }
+}
+BENCHMARK(BM_CompareRunCoreOwnReference)->Args({1000, 0})->Args({1000, 1})->Unit(benchmark::kMillisecond);
+
 // Containment after one step of a gas (runner.cpp calls it after every step of every
 // run): `range(0)` circles (r = 0.05 m) `range(1)` mm apart in a walled box (220: as
 // scripts/make_gas.py makes them, 16% packing; 162: circle_gas's 30%, where most x

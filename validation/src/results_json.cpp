@@ -88,7 +88,7 @@ json run_to_json_without_lists(const RunRecord& r) {
   }
   json settings = json::object();
   for (const auto& [k, v] : r.settings) settings[k] = v;
-  return {{"scenario", r.scenario},
+  json j = {{"scenario", r.scenario},
           {"engine", r.engine},
           {"engine_version", r.engine_version},
           {"precision", r.precision},
@@ -104,6 +104,12 @@ json run_to_json_without_lists(const RunRecord& r) {
           {"limits_hit", r.limits_hit},
           {"metrics", metrics},
           {"checks", checks}};
+  if (r.reference_check.applies) {
+    const ReferenceCheck& c = r.reference_check;
+    j["reference_check"] = {{"judged", c.judged}, {"note", c.note},   {"ratio", opt(c.ratio)}, {"error", opt(c.error)},
+                            {"limit", opt(c.limit)}, {"time", opt(c.time)}, {"body", c.body}};
+  }
+  return j;
 }
 
 }  // namespace

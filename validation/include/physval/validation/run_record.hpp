@@ -134,6 +134,23 @@ struct ContainmentRecord {
   std::optional<double> judged_first_escape_time;
 };
 
+// The reference engine's (core's) run held against its own converged reference
+// (comparator.cpp, judge_against_own_reference; README "The reference"): where core claims
+// exact paths at the scene's step (exact impacts, velocity Verlet or RK4, no force that
+// varies within a step), its run must meet the reference within the per-body limit the
+// reference's two runs are held to, or it is `diverged`. Written to results.json as
+// `reference_check` for the reference engine's runs only.
+struct ReferenceCheck {
+  bool applies = false;          // the run is the reference engine's
+  bool judged = false;           // held to the reference (else `note` says why not)
+  std::string note;              // why not judged, or what was measured
+  std::optional<double> ratio;   // worst |x - x_ref| / limit_i over samples and scene bodies
+  std::optional<double> error;   // m, the difference at the worst sample
+  std::optional<double> limit;   // m, that body's limit
+  std::optional<double> time;    // s, the worst sample's time
+  std::string body;              // the worst body
+};
+
 struct RunRecord {
   std::string scenario;
   std::string engine;
@@ -169,6 +186,7 @@ struct RunRecord {
   // the parent thread's CPU for the run (fork, reading the record; in-process: all of it).
   double parent_cpu_seconds = 0.0;
   std::vector<Setting> settings;
+  ReferenceCheck reference_check;   // set by the comparator (reference engine's runs only)
   std::vector<std::string> limits_hit;
   std::vector<BodyMeta> bodies;
   std::vector<ContactRecord> contacts;
