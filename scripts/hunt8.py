@@ -35,6 +35,10 @@ Families:
                corner, a surface's tip and a wall's end; a run whose ball went on untouched,
                apart from the barrier at both ends of the step it passed the corner in (a skipped
                impact), must not be `ok`.
+  zeno         a ball dropped on a floor at e 0.5-0.99 (ball and floor), steps of 0.5-100 of its
+               falls (--quick: h 0.1 m, e 0.95 and 0.99, 10 and 30 falls): the bounces' closed form,
+               at rest from t_fall (1 + e) / (1 - e); core exact (it ended the Zeno sequence early,
+               `ok`, before zeno10); also sliding along the frictionless floor at 0.5 m/s.
   ledge        a ball sliding off a box, a surface or two walls (0.3-8 m/s): flying off, or
                turning about the corner until the normal force is 0 (RK4), then flying.
 
@@ -514,6 +518,47 @@ restitution = 1.0
             truth[name] = dict(final={"b": ((0.0, y + r), (0.0, vy))}, exact=False, scale=h)
 
 
+# ---------------------------------------------------------------- zeno
+def gen_zeno(out, truth, quick):
+    """A ball dropped on a floor at restitution 0.5-0.99 (ball and floor), steps of 0.5-100 of its
+    falls, the duration 2 dt + 0.37 t_fall: the bounces' closed form, ending at rest at
+    t_fall (1 + e) / (1 - e) (core ended the Zeno sequence at the first rebound slower than its
+    rest speed |a| dt / 16 and held the ball at once; at e 0.95, 10 falls, 8.6 mm early for a drop
+    of 0.1 m, `ok`: fixed on zeno10). Also the ball sliding along the floor at 0.5 m/s
+    (frictionless: the impacts change only its normal speed). core exact."""
+    r = 0.1
+    for h in ([0.1] if quick else [0.01, 0.1, 1.0]):
+        tf = math.sqrt(2 * h / G0)
+        for e in ([0.95, 0.99] if quick else [0.5, 0.7, 0.9, 0.95, 0.99]):
+            for mult in ([10.0, 30.0] if quick else [0.5, 3.0, 10.0, 30.0, 100.0]):
+                for u in ([0.0] if quick else [0.0, 0.5]):
+                    dt = mult * tf
+                    T = 2 * dt + 0.37 * tf
+                    y, vy = bounce_state(h, e, T)
+                    if T >= tf * (1 + e) / (1 - e):
+                        y, vy = 0.0, 0.0   # at rest (the Zeno limit)
+                    name = f"zeno_h{ident(h)}_e{ident(e)}_x{ident(mult)}" + (f"_u{ident(u)}" if u else "")
+                    L = 2.0 + u * T
+                    write(out, name, f"""name = "{name}"
+duration = {fmt(T)}
+dt = {fmt(dt)}
+[world]
+gravity = [0.0, {fmt(-G0)}]
+[[bodies]]
+name = "b"
+radius = {fmt(r)}
+position = [0.0, {fmt(h + r)}]
+velocity = [{fmt(u)}, 0.0]
+restitution = {fmt(e)}
+[[walls]]
+name = "floor"
+from = [{fmt(-L)}, 0.0]
+to = [{fmt(L)}, 0.0]
+restitution = {fmt(e)}
+""")
+                    truth[name] = dict(final={"b": ((u * T, y + r), (u, vy))}, exact=True, scale=h)
+
+
 # ---------------------------------------------------------------- sliver
 def gen_sliver(out, truth, quick):
     """A free ball and a ball bouncing on a floor over a whole number of steps and a sliver (the
@@ -732,7 +777,7 @@ def judge(name, t, runs, ref, out, find):
 
 
 FAMILIES = {"thrustfloor": gen_thrustfloor, "thrustslope": gen_thrustslope, "windfloor": gen_windfloor, "quadwind": gen_quadwind, "newtoncoll": gen_newtoncoll,
-            "scale": gen_scale, "hugedt": gen_hugedt, "sliver": gen_sliver, "boxcorner": gen_boxcorner, "ledge": gen_ledge}
+            "scale": gen_scale, "hugedt": gen_hugedt, "sliver": gen_sliver, "boxcorner": gen_boxcorner, "ledge": gen_ledge, "zeno": gen_zeno}
 
 
 def main(argv):

@@ -64,7 +64,8 @@ class EventLoop {
         T_(ctx.dt),
         coupled_(w.coupled()),
         fast_isolated_(w.impact_law == ImpactLaw::Simultaneous && !w.any_rules && !w.any_forces && !w.varying_forces &&
-                       !w.coupled()) {
+                       !w.coupled()),
+        zeno_tails_(w.zeno_tails()) {
     // A few faces: their boxes, as StaticGeometry builds them, to skip its query for
     // a box that meets none (most bodies of a walled gas, away from the walls).
     if (w.statics.segments.size() <= kFewFaces) {
@@ -207,6 +208,10 @@ class EventLoop {
 
   void schedule_pair(std::uint32_t i, std::uint32_t j, double t) {
     if (i == j) return;
+    if (!tails_.empty()) {   // a body met inside its Zeno tail: back to its state at t (zeno_tail)
+      unwind_tail(i, t);
+      unwind_tail(j, t);
+    }
     const std::uint8_t fi = w_.flags[i], fj = w_.flags[j];
     if (!(fi & kAlive) || !(fj & kAlive)) return;
     if ((fi & kStatic) && (fj & kStatic)) return;
@@ -1000,6 +1005,8 @@ class EventLoop {
     const double vr = pressed ? w_.impact_rest_speed(an, ctx_.dt, m.restitution, vn) : 0.0;
     const bool slow = pressed && m.restitution * std::max(0.0, -vn) < vr;
     const bool own_support = w_.supported(i) && w_.support[i] == k;
+    // A lone body's slow impact on one face: its whole Zeno sequence in closed form.
+    if (slow && face && zeno_tails_ && !own_support && zeno_tail(i, k, n, n_resp, m, vn, an, t, t_abs, r.event)) return;
     // A gas's wall impact with nothing else near: the pairwise response, its new path's
     // broad-phase query asked once, wide enough to prove that the touching set would
     // hold this face's contact only (isolated_static).
@@ -1073,6 +1080,195 @@ class EventLoop {
     free_dependents(i, t);
   }
 
+  // A Zeno tail taken in closed form (zeno_tail): body i left face `face` at t0 from p with
+  // normal speed v0 along n (restitution e, normal acceleration -a), tangential velocity vt
+  // and acceleration at; at rest at t0 + D, D = 2 v0 / (a (1 - e)). The body was put at its
+  // state at t_end (the rest, or the step's end) with version `version`.
+  struct Tail {
+    std::uint32_t body, face, version;
+    double t0, t_end, D, v0, a, e;
+    Vec2 p, vt, at, n;
+  };
+
+  // The closed form of a Zeno tail at time s (z.t0 <= s): position and velocity. Bounce k
+  // (k = 0, 1, ...) leaves the face at t0 + D (1 - e^k) with normal speed v0 e^k; from
+  // t0 + D the body rests on the face (normal speed 0, the tangential motion goes on).
+  static void tail_state(const Tail& z, double s, Vec2& pos, Vec2& vel) {
+    const double u = std::max(0.0, s - z.t0);
+    const Vec2 along = z.p + u * z.vt + (0.5 * u * u) * z.at;
+    const Vec2 vt = z.vt + u * z.at;
+    if (u >= z.D) {
+      pos = along;   // at rest on the face (moving along it)
+      vel = vt;
+      return;
+    }
+    // The bounce in progress: the last k with D (1 - e^k) <= u, i.e. e^k >= 1 - u / D.
+    const double left = 1.0 - u / z.D;   // in (0, 1]
+    int k = left < 1.0 ? static_cast<int>(std::floor(std::log(left) / std::log(z.e))) : 0;
+    k = std::max(k, 0);
+    const auto start = [&](int q) { return z.D * (1.0 - std::pow(z.e, q)); };
+    while (k > 0 && start(k) > u) --k;
+    while (start(k + 1) <= u && z.D * std::pow(z.e, k + 1) > 0.0) ++k;
+    const double sig = u - start(k);
+    const double vk = z.v0 * std::pow(z.e, k);
+    const double h = std::max(0.0, sig * (vk - 0.5 * z.a * sig));
+    pos = along + h * z.n;
+    vel = vt + (vk - z.a * sig) * z.n;
+  }
+
+  // The last impact of a tail at or before s (step time).
+  static double tail_last_impact(const Tail& z, double s) {
+    const double u = s - z.t0;
+    if (u >= z.D) return z.t0 + z.D;
+    const double left = 1.0 - u / z.D;
+    int k = left < 1.0 ? std::max(0, static_cast<int>(std::floor(std::log(left) / std::log(z.e)))) : 0;
+    while (k > 0 && z.D * (1.0 - std::pow(z.e, k)) > u) --k;
+    while (z.D * (1.0 - std::pow(z.e, k + 1)) <= u) ++k;
+    return z.t0 + z.D * (1.0 - std::pow(z.e, k));
+  }
+
+  // Body i, free, meets face k at t slowly enough to collapse (`slow`: its rebound e |v_n|
+  // below the rest speed v_r): the rest of its Zeno sequence there is geometric. With
+  // nothing else within reach of the tail (no other body's registered path, no other face),
+  // a static face, constant acceleration a_n < 0 along n (World::zeno_tails) and a
+  // frictionless impact with 0 < e < 1 (World::zeno_material), bounce k lasts 2 v e^k / a
+  // (v = e |v_n|, a = |a_n|) and the body comes to rest at t + 2 v / (a (1 - e)) exactly;
+  // across the face it moves with constant acceleration throughout. It is put there at
+  // once (at rest on the face from then), or, when the step ends inside the tail, at the
+  // closed form's state at the step's end (free, in bounce n). Before, the body was held at
+  // once (up to 2 v_r / ((1 - e) a) early: at a step of many falls, a rebound whose apex is
+  // a large fraction of the drop). A body that another's new path reaches inside the tail
+  // is put back at its closed-form state then (unwind_tail) and goes on bounce by bounce.
+  // Contacts: the tail's impacts continue this one's contact (record_contact), except an
+  // impact after a flight longer than the contact window (only with a fixed rest_speed),
+  // which is recorded at its time; the pair's last touch is the tail's last impact in the
+  // step. stats.impacts counts the tail as this one impact. Returns false (nothing changed)
+  // when a condition fails: the caller's collapse decides as before.
+  bool zeno_tail(std::uint32_t i, std::uint32_t k, Vec2 n, Vec2 n_resp, const PairMaterial& m, double vn, double an,
+                 double t, double t_abs, bool event) {
+    if (!World::zeno_material(m) || !(vn < 0.0) || !(an < 0.0) || n_resp != n) return false;
+    if (w_.supported(i) || w_.stationary(i) || !(w_.radius[i] > 0.0) || !(w_.inv_mass[i] > 0.0)) return false;
+    if (w_.flags[i] & (kParticle | kPoint | kDestroyOnHit)) return false;
+    if (!w_.dep_head.empty() && w_.dep_head[i] != kNone) return false;
+    const Segment& seg = w_.statics.segments[k];
+    const double e = m.restitution, a = -an;
+    const Vec2 v = w_.vel[i], p = w_.pos[i];
+    const double v0 = e * -vn;
+    if (!(v0 > 0.0)) return false;
+    const double D = 2.0 * v0 / (a * (1.0 - e));
+    if (!std::isfinite(D)) return false;
+    const Vec2 vt = v - vn * n, at = w_.acc[i] - an * n;
+    const double S = std::min(D, T_ - t);   // the tail's part in this step
+    // The box of the centre's path over the tail: along the face a parabola, across it at
+    // most v0^2 / (2 a) from the contact.
+    double lo_x = p.x, hi_x = p.x, lo_y = p.y, hi_y = p.y;
+    const auto take = [&](double s) {
+      const Vec2 q = p + s * vt + (0.5 * s * s) * at;
+      lo_x = std::min(lo_x, q.x);
+      hi_x = std::max(hi_x, q.x);
+      lo_y = std::min(lo_y, q.y);
+      hi_y = std::max(hi_y, q.y);
+    };
+    take(S);
+    if (at.x != 0.0 && -vt.x / at.x > 0.0 && -vt.x / at.x < S) take(-vt.x / at.x);
+    if (at.y != 0.0 && -vt.y / at.y > 0.0 && -vt.y / at.y < S) take(-vt.y / at.y);
+    const Vec2 up = (v0 * v0 / (2.0 * a)) * n;
+    lo_x += std::min(0.0, up.x);
+    hi_x += std::max(0.0, up.x);
+    lo_y += std::min(0.0, up.y);
+    hi_y += std::max(0.0, up.y);
+    // Its contact stays on the face's interior throughout (its projection is a parabola in
+    // time: checked at both ends and at its turn).
+    const double ud = dot(vt, seg.dir), ua = dot(at, seg.dir), u0 = dot(p - seg.from, seg.dir);
+    const auto on_face = [&](double s) {
+      const double u = u0 + s * ud + 0.5 * s * s * ua;
+      return u >= 0.0 && u <= seg.length;
+    };
+    if (!on_face(0.0) || !on_face(S)) return false;
+    if (ua != 0.0 && -ud / ua > 0.0 && -ud / ua < S && !on_face(-ud / ua)) return false;
+    const double r = w_.radius[i];
+    const double tol = 1e-9 * (r + w_.length_scale + inf_norm(p));
+    const Aabb tail_box = make_aabb(lo_x - r - tol, lo_y - r - tol, hi_x + r + tol, hi_y + r + tol);
+    // Alone: no other body's registered path box and no other face within reach of the tail
+    // (widened by the rest speed's reach, the holds' query pad, so that no other body's
+    // touching-set or hold query at the tail's times can find this one).
+    const double reach = r + w_.rest_speed(length(w_.acc[i]), ctx_.dt) * ctx_.dt + tol;
+    const Aabb wide = make_aabb(lo_x - reach, lo_y - reach, hi_x + reach, hi_y + reach);
+    near_.clear();
+    w_.bp->query_box(wide, i, near_);
+    for (std::uint32_t x : near_) {
+      if (x != i && w_.alive(x)) return false;
+    }
+    w_.found_static.clear();
+    w_.statics.query(wide, w_.found_static);
+    for (std::uint32_t o : w_.found_static) {
+      if (o != k) return false;
+    }
+    // Taken. Contacts: this impact, and any after a flight longer than the window.
+    const std::uint32_t partner = static_partner_key(seg.owner);
+    if (event) {
+      record_contact(w_, i, kNone, &seg, t_abs, ctx_.dt);
+      double tk = t, vk = v0;
+      for (int q = 0; q < 64; ++q) {   // flights shrink: only the first few can exceed dt
+        const double flight = 2.0 * vk / a;
+        if (!(flight > ctx_.dt) || tk + flight > t + S) break;
+        tk += flight;
+        vk *= e;
+        record_contact(w_, i, kNone, &seg, ctx_.t0 + tk, ctx_.dt);
+      }
+    }
+    Tail z{i, k, 0u, t, t + S, D, v0, a, e, p, vt, at, n};
+    Vec2 pos, vel;
+    tail_state(z, t + S, pos, vel);
+    if (event) touch_contact(w_, i, partner, ctx_.t0 + tail_last_impact(z, t + S));
+    w_.pos[i] = pos;
+    w_.vel[i] = vel;
+    w_.tloc[i] = t + S;
+    ++w_.version[i];
+    w_.bp->grow(i, tail_box);
+    if (D <= T_ - t) {
+      // At rest on the face from t + D (the normal speed is 0 there: settle_on_face
+      // removes only round-off).
+      settle_on_face(w_, i, k, n, m);
+      ++w_.version[i];
+      reschedule(i, t + D);
+    } else {
+      w_.apath[i] = w_.acc[i];   // free, in bounce n at the step's end
+    }
+    z.version = w_.version[i];
+    tails_.push_back(z);
+    return true;
+  }
+
+  // Body x, inside a Zeno tail taken in closed form whose state is set at a later time than
+  // t: put back at its closed-form state at t, free, and (resched) its events found from
+  // there (the next impact of its bounce is an event again).
+  void unwind_tail(std::uint32_t x, double t, bool resched = true) {
+    if (!(t < w_.tloc[x])) return;
+    for (std::size_t q = 0; q < tails_.size(); ++q) {
+      Tail& z = tails_[q];
+      if (z.body != x) continue;
+      const bool live = z.version == w_.version[x] && t >= z.t0;
+      const Tail keep = z;
+      tails_.erase(tails_.begin() + static_cast<std::ptrdiff_t>(q));
+      if (!live) return;
+      Vec2 pos, vel;
+      tail_state(keep, t, pos, vel);
+      if (w_.supported(x)) release_support(w_, x);
+      w_.pos[x] = pos;
+      w_.vel[x] = vel;
+      w_.tloc[x] = t;
+      w_.apath[x] = w_.acc[x];
+      ++w_.version[x];
+      const Segment& seg = w_.statics.segments[keep.face];
+      if (w_.response(w_.group[x], seg.group).event) {
+        touch_contact(w_, x, static_partner_key(seg.owner), ctx_.t0 + tail_last_impact(keep, t));
+      }
+      if (resched) reschedule(x, t);
+      return;
+    }
+  }
+
   // Whether body i (advanced to now) touches a face other than k, at rest or closing (the
   // same round-off window as the simultaneous set's contacts), along another normal than
   // k's contact normal `nk`: the next piece of a floor drawn in pieces (a junction) is the
@@ -1108,6 +1304,7 @@ class EventLoop {
     ++w_.cap_hits;
     w_.events.clear();
     for (std::uint32_t i = 0; i < w_.size(); ++i) {
+      if (!tails_.empty()) unwind_tail(i, t, false);
       if (w_.dynamic(i)) w_.advance(i, t);
     }
     collide_lecture(w_, ctx_, t);
@@ -1120,6 +1317,8 @@ class EventLoop {
   // Free flight, no collision rules, the simultaneous law: an impact with nothing else
   // near is the pairwise law's, proven without the touching set (isolated_pair).
   const bool fast_isolated_;
+  const bool zeno_tails_;   // World::zeno_tails
+  std::vector<Tail> tails_;
   Aabb found_box_i_, found_box_j_;   // the new paths' boxes isolated_pair/_static found
   static constexpr std::uint32_t kFewFaces = 8, kManyFaces = 0xffffffffu;
   Aabb face_boxes_[kFewFaces];       // the faces' boxes, when there are few (face_count_)

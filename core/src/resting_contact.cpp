@@ -714,6 +714,28 @@ bool leaning_group_holds(World& w, std::uint32_t i, std::span<const HeldContact>
 
 }  // namespace
 
+// A free body whose only contact is one face with 0 < e < 1, frictionless, that it meets or
+// leaves faster than round-off (a step that ends at a bounce of its Zeno sequence), where
+// World::zeno_tails: not held at the step's start (neither alone nor as a group's pocket);
+// the event loop ends its sequence at the closed-form time (zeno_tail, exact_collisions.cpp).
+// Held here it stopped early (up to 2 v_r / ((1 - e) |a|)).
+static bool zeno_bounce(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near) {
+  if (!w.zeno_tails() || w.supported(i) || (w.flags[i] & (kParticle | kPoint | kDestroyOnHit)) != 0) return false;
+  if (w.acc.empty()) return false;
+  thread_local std::vector<HeldContact> contacts;
+  thread_local std::vector<double> mu, rest_e;
+  contacts.clear();
+  mu.clear();
+  rest_e.clear();
+  touching_supports(w, i, near, contacts, mu, &rest_e);
+  if (contacts.size() != 1 || !(contacts[0].other & kBodySupport)) return false;
+  const Segment& s = w.statics.segments[contacts[0].other & ~kBodySupport];
+  if (!World::zeno_material(w.pair_material(w.material[i], s.material))) return false;
+  const double vn = dot(w.vel[i], contacts[0].n);
+  const double an = dot(w.acc[i], contacts[0].n);
+  return an < 0.0 && std::fabs(vn) > 64.0 * 2.220446049250313e-16 * (length(w.vel[i]) + std::fabs(an) * dt);
+}
+
 bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near, bool settle_into_pocket) {
   if (!w.dynamic(i) || w.is_held(i) || w.acc.empty()) return false;
   const Vec2 a = w.acc[i];
@@ -1671,8 +1693,16 @@ void detect_support(World& w, std::uint32_t i, const StepContext& ctx) {
     // face and its neighbour as impacts at once, and never became a train).
     // Moving into it: settled below the rest speed, an elastic face (e = 1) only at
     // round-off (World::impact_rest_speed: it bounces).
-    const double e = w.pair_material(w.material[i], s.material).restitution;
+    const PairMaterial m = w.pair_material(w.material[i], s.material);
+    const double e = m.restitution;
     if (vn > 64.0 * 2.220446049250313e-16 * length(w.vel[i]) || -vn > w.impact_rest_speed(an, ctx.dt, e, vn)) continue;
+    // A frictionless face with 0 < e < 1 met faster than round-off where World::zeno_tails (a
+    // step that ends just before a bounce of a Zeno sequence): an impact, whose sequence the
+    // event loop ends at its closed-form time (zeno_tail); settled here it stopped early.
+    if (w.zeno_tails() && World::zeno_material(m) && (w.flags[i] & (kParticle | kPoint | kDestroyOnHit)) == 0 &&
+        -vn > 64.0 * 2.220446049250313e-16 * (length(w.vel[i]) + std::fabs(an) * ctx.dt)) {
+      continue;
+    }
     w.support[i] = k;
     w.support_n[i] = n;
     record_contact(w, i, kNone, &s, ctx.t0, ctx.dt);
@@ -1849,6 +1879,7 @@ bool hold_pass(World& w, const StepContext& ctx) {
     if (driven && in_a_train(i)) continue;   // push_trains judges it
     grid.query(w.pos[i], near);
     group.clear();
+    if (zeno_bounce(w, i, ctx.dt, near)) continue;
     if (try_hold(w, i, ctx.dt, near)) {
       group.push_back(i);
     } else if (!w.supported(i)) {

@@ -377,6 +377,18 @@ struct World {
     }
     return rest_speed(a_n, dt);
   }
+  // A lone body's Zeno sequence on one face (its bounces after a slow impact, restitution
+  // 0 < e < 1, frictionless) is taken in closed form by the event loop (exact_collisions.cpp,
+  // zeno_tail) where its acceleration is constant over the tail: uniform gravity only (no
+  // drag, wind, thrust or Newtonian gravity: varying_forces), no collision rules, no
+  // emitters, an integrator exact for constant forces, exact impacts.
+  bool zeno_tails() const {
+    return mode == CollisionMode::Exact && !varying_forces && !any_rules && !newtonian && emitters.empty() &&
+           (integrator == Integrator::VelocityVerlet || integrator == Integrator::Rk4);
+  }
+  static bool zeno_material(const PairMaterial& m) {
+    return m.restitution > 0.0 && m.restitution < 1.0 && !(m.friction > 0.0) && !(m.static_friction > 0.0);
+  }
   // Inelastic collapse: an impact of bodies i and j closing slower than this is
   // perfectly inelastic (restitution falls to 0): the rest speed of the larger of their
   // accelerations. 0 in a scene without forces. This is the speed for a pair whose

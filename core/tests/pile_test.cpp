@@ -365,4 +365,106 @@ INSTANTIATE_TEST_SUITE_P(FrictionlessPiles, CorePileSettles,
                                   std::to_string(test_info.param.seed) + "_mu0";
                          });
 
+// A frictionless crystal: rows of 10 and 9 circles (r 0.125, exactly representable) in a box
+// exactly 10 diameters wide, each row dropped from 0.05 m above its place in the hexagonal
+// packing (the bottom row on the floor, touching its neighbours and both walls). Every ball
+// above the bottom row lands in a pocket, or against a wall and one ball; the packing is an
+// equilibrium without friction, so the pile must end exactly there: x = r (2i + 1) (rows of
+// 10) or r (2i + 2) (rows of 9), y = r + row sqrt(3) r. The scene is mirror-symmetric.
+// On main (a3fdafd) the 4-row crystal never finished a step: a landing row's set (up to 76
+// contacts, every ball of the crystal) did not converge in Gauss-Seidel (hyperstatic: its
+// Delassus matrix is singular), and the exact solve it falls back to was refused because two
+// resting balls came out at 1e-16 m/s against a tolerance of ~1e-29 m/s (1024 ulps of their
+// own speeds, 0, while the projection is exact to round-off of the whole set's |u|), so the
+// set ran 100,000 sweeps and met the same impact again at the same instant, for ever. The
+// 3-row crystal at e 0 failed there too: 7.6e-10 m off the packing and its mirror image.
+struct CrystalCase {
+  int rows;
+  double e;
+  double bound;   // distance from the closed-form packing and from the mirror image, m
+};
+
+Scene crystal(int rows, double e) {
+  constexpr double r = 0.125, gap = 0.05;
+  constexpr int k = 10;
+  Scene s;
+  s.name = "crystal";
+  s.world.gravity = {0.0, -g};
+  for (int row = 0; row < rows; ++row) {
+    const int cnt = row % 2 == 0 ? k : k - 1;
+    for (int i = 0; i < cnt; ++i) {
+      const double x = row % 2 == 0 ? r * (2 * i + 1) : r * (2 * i + 2);
+      BodyDef b = circle("r" + std::to_string(row) + "_" + std::to_string(i), {x, r + row * std::sqrt(3.0) * r + row * gap},
+                         {}, r, 1.0, e);
+      b.friction = b.static_friction = 0.0;
+      s.bodies.push_back(b);
+    }
+  }
+  const double W = 2.0 * r * k, H = 20.0;
+  s.walls = {wall("floor", {0.0, 0.0}, {W, 0.0}, e), wall("right", {W, 0.0}, {W, H}, e),
+             wall("lid", {W, H}, {0.0, H}, e), wall("left", {0.0, H}, {0.0, 0.0}, e)};
+  return s;
+}
+
+class CoreCrystal : public ::testing::TestWithParam<CrystalCase> {};
+
+TEST_P(CoreCrystal, AFrictionlessCrystalSettlesIntoItsPackingSymmetrically) {
+  const CrystalCase c = GetParam();
+  constexpr double r = 0.125;
+  constexpr int k = 10;
+  Sim sim(crystal(c.rows, c.e));
+  const std::size_t n = sim.scene.bodies.size();
+  const double v_r = g * dt / 16.0;
+  const double micro_bounces = static_cast<double>(n) * 0.5 * (0.5 * v_r) * (0.5 * v_r);
+  sim.engine.read_states(sim.states);
+  const double E0 = energy(sim.states, sim.scene);
+  double E_prev = E0;
+  std::int64_t last_events = -1;
+  for (int step = 0; step < 180; ++step) {   // 3 s; every row has landed by 0.5 s
+    sim.step(dt);
+    ASSERT_FALSE(sim.engine.last_step_stats().event_cap_hit) << "step " << step;
+    EXPECT_EQ(sim.engine.broken_guarantee(), "") << "step " << step;
+    sim.engine.read_states(sim.states);
+    const double E = energy(sim.states, sim.scene);
+    ASSERT_LE(E, E_prev + 1e-12 * std::fabs(E_prev) + micro_bounces) << "step " << step;
+    ASSERT_LE(E, E0 + 1e-12 * std::fabs(E0)) << "step " << step;
+    ASSERT_LE(deepest_overlap(sim.states, sim.scene), 1e-9) << "step " << step;
+    E_prev = E;
+    last_events = sim.engine.last_step_stats().events;
+  }
+  EXPECT_EQ(last_events, 0);
+  EXPECT_TRUE(sim.engine.limits_hit().empty());
+  std::size_t b = 0;
+  for (int row = 0; row < c.rows; ++row) {
+    const int cnt = row % 2 == 0 ? k : k - 1;
+    const std::size_t first = b;
+    for (int i = 0; i < cnt; ++i, ++b) {
+      const BodyState& s = sim.states[b];
+      EXPECT_EQ(s.velocity, Vec2{}) << sim.scene.bodies[b].name;
+      const Vec2 want{row % 2 == 0 ? r * (2 * i + 1) : r * (2 * i + 2), r + row * std::sqrt(3.0) * r};
+      EXPECT_LE(length(s.position - want), c.bound) << sim.scene.bodies[b].name;
+      const BodyState& m = sim.states[first + static_cast<std::size_t>(cnt - 1 - i)];
+      EXPECT_LE(length(Vec2{s.position.x + m.position.x - 2.0 * r * k, s.position.y - m.position.y}), c.bound)
+          << sim.scene.bodies[b].name << " and its mirror image";
+    }
+  }
+}
+
+// 3 rows (29 circles) end on the closed form and symmetric to round-off. 4 rows (38) at e 0:
+// measured 6.9e-9 m off the closed form (and from the mirror image); the bound is the largest
+// move core's model makes at rest, a pocket hold's v_r dt = g dt^2 / 16 (1.7e-4 m; README,
+// Pockets), not round-off: the frictionless solve takes its contacts in the order they were
+// found, so the mirror pairs differ by round-off that the landings grow. Not here (README,
+// Frictionless piles): 4 rows at e 0.3 and 0.7 end 2.7e-6 and 7.7e-6 m off and are reported
+// ("could not show to hold it": the braced judgement's solver does not converge on the
+// hyperstatic crystal, a false report), 5 rows and more still spend minutes in one step
+// (the exact solve's least-distance reduction picks a wrong active set there).
+INSTANTIATE_TEST_SUITE_P(Crystals, CoreCrystal,
+                         ::testing::Values(CrystalCase{3, 0.0, 1e-12}, CrystalCase{3, 0.3, 1e-12},
+                                           CrystalCase{4, 0.0, g * dt * dt / 16.0}),
+                         [](const auto& test_info) {
+                           return "rows" + std::to_string(test_info.param.rows) + "_e" +
+                                  std::to_string(static_cast<int>(test_info.param.e * 10));
+                         });
+
 }  // namespace physval::test

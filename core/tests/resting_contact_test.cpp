@@ -531,6 +531,20 @@ TEST(CoreResting, APyramidCoreCannotJustifyHoldingIsABrokenGuarantee) {
   }
 }
 
+// Still disabled (branch piles10, 2026-11-25): not a fault a local fix can remove. Below
+// mu = 1 / (3 sqrt 3) the closed form is a motion *under* contact forces: the top slides down
+// both bottom balls with N > 0 at each contact the whole time (a_t = g (1 - 3 sqrt 3 mu) /
+// (7 - sqrt 3 mu)), an index-2 constrained motion with three bodies in persistent contact.
+// core's exact mode has two models of a contact, neither of which is that: a held body (v = 0,
+// no path; the braced judgement reports the hold, APyramidCoreCannotJustifyHoldingIsABroken-
+// Guarantee above) and free flights between impacts (which, for a top pressed into bodies that
+// give way, is the inelastic collapse: micro-bounces of >= dt/16 whose mean motion is not the
+// closed form's, off at first order in dt). Passing needs a third: a group of free bodies
+// moving on the acceleration-level contact problem (the LCP the braced judgement already
+// solves, A f >= -b, f >= 0, complementary) between events, with lift-off (f -> 0), a new
+// contact and a stop as its exact events, and its own integrator (positions drift off the
+// constraint at the integrator's order without a projection). That is a new engine mode, not
+// done here.
 TEST(CoreResting, DISABLED_PyramidOfThreeCollapsesIffRigidCoulombSays) {
   const double s3 = std::sqrt(3.0);
   for (double mu : {0.0, 0.1, 0.15, 0.3, 1.0}) {
