@@ -18,11 +18,14 @@ namespace physval::core_detail {
 namespace {
 
 // Coulomb friction as a change of relative tangential velocity: dvt = the whole
-// tangential velocity if mu_s allows it (stick), else mu_k times the normal change.
+// tangential velocity if mu_k times the normal change stops it (stick), else mu_k times it.
 double friction_change(double vt, double dvn, const PairMaterial& m) {
   if (vt <= 0.0 || dvn <= 0.0) return 0.0;
   if (m.friction <= 0.0 && m.static_friction <= 0.0) return 0.0;
-  if (vt <= m.static_friction * dvn) return vt;
+  // A sliding contact slides through the impact: only kinetic friction acts while it slides, and
+  // the contact sticks (static friction then holds it) only where the kinetic impulse stops it
+  // within the impact. Sticking whenever vt <= mu_s dvn stopped contacts that slide through
+  // (mu_s > mu_k: the tenth hunt's impactstick family).
   return std::min(m.friction * dvn, vt);
 }
 

@@ -287,7 +287,14 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
     const auto add = [&](Contact& c, double restitution, double mu_s, double mu_k) {
       c.mu_s = std::max(mu_s, mu_k);
       c.mu_k = mu_k;
-      const double wn = dot(vel_now(w, c.b, t) - ((c.a & kSegmentContact) ? Vec2{} : vel_now(w, c.a, t)), c.n);
+      const Vec2 va = (c.a & kSegmentContact) ? Vec2{} : vel_now(w, c.a, t);
+      const Vec2 vb = vel_now(w, c.b, t);
+      const double wn = dot(vb - va, c.n);
+      // A contact that slides when the impact begins slides through it: kinetic friction is
+      // its cone (it sticks only where mu_k's impulse stops it); static friction is the cone of
+      // a contact at rest (to round-off of its bodies' speeds). The same law as a lone pair's
+      // impact (collision_response.cpp, friction_change).
+      if (std::fabs(dot(vb - va, perp(c.n))) > 64.0 * 2.220446049250313e-16 * (length(va) + length(vb))) c.mu_s = mu_k;
       const std::uint32_t other = (c.a & kSegmentContact) ? c.b : c.a;
       const bool slow = (c.a & kSegmentContact) ? -wn < w.collapse_speed(other, c.b) : collapses(w, c.a, c.b, t, -wn);
       const double e = slow ? 0.0 : restitution;
