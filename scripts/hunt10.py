@@ -19,7 +19,7 @@ Families:
                conserved (or can only be lost) in a scene that gains it at every bounce.
   matstatic    static friction given only through [[materials]] (mu_s > mu_k for the pair): an
                engine that cannot model static friction must not run it as `ok`.
-  matzero      an override `friction = 0.0` between rough materials (the pair keeps mu_s): the same.
+  matzero      an override `friction = 0.0` between rough materials: a frictionless pair, sliding.
   impactstick  a ball dropped with a horizontal speed onto a floor with mu_s > mu_k (core only):
                the contact slides through the impact, so kinetic friction acts (core stuck it
                whenever u <= mu_s (1 + e) v_n; fixed).
@@ -364,11 +364,11 @@ static_friction = {fmt(mus)}
 # ---------------------------------------------------------------- matzero
 def gen_matzero(out, truth, quick):
     """A ball at rest on a slope, both materials rough (mu 0.5), and a [[materials]] override
-    `friction = 0.0` for the pair. The rule (combine_materials) keeps the pair's static friction
-    0.5 (an entry giving only `friction` sets mu_s = max(mu_s, friction)), so the pair has
-    mu_s 0.5 > tan th > mu_k 0: held (what core does). An engine with one coefficient slides at
-    g sin th and must not be `ok` (before the tenth hunt all four were, 1-2 m down the slope).
-    Whether a user writing `friction = 0.0` means that is a question for the rule (README)."""
+    `friction = 0.0` for the pair. An entry giving only `friction` gives the pair one coefficient
+    (mu_s = mu_k, as a body with `friction` alone): the pair is frictionless and the ball slides
+    at g sin th on every engine. (The rule first kept the pair's static friction, mu_s =
+    max(mu_s, friction): core held the ball while the four others slid it, `ok`; then it was the
+    feature static_friction, unsupported on the four; now what a user writing it means.)"""
     for th in ([0.35] if quick else [0.2, 0.35, 0.45]):
         r, L, T, mu = 0.1, 20.0, 1.0, 0.5
         nx, ny = -math.sin(th), math.cos(th)
@@ -399,7 +399,8 @@ a = "ball"
 b = "slope"
 friction = 0.0
 """)
-        truth[name] = dict(final={"ball": (x0, (0.0, 0.0))}, exact=True, scale=1.0, one_coefficient=True)
+        truth[name] = dict(final={"ball": ((x0[0] + s * d[0], x0[1] + s * d[1]), (v * d[0], v * d[1]))}, exact=True,
+                           scale=1.0)
 
 
 # ---------------------------------------------------------------- impactstick

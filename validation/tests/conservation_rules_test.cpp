@@ -198,12 +198,21 @@ TEST(ConservationRulesUnit, StaticFrictionFromAnOverrideIsAFeature) {
   EXPECT_TRUE(has(physval::Feature::StaticFriction));
   s.materials[0].friction = 0.7;   // mu_s = mu_k: one coefficient
   EXPECT_FALSE(has(physval::Feature::StaticFriction));
-  // an override of the kinetic friction alone keeps the pair's static friction (the rule's
-  // max(mu_s, friction)): `friction = 0.0` between rough materials leaves mu_s 0.2 > mu_k 0
+  // an override of the friction alone gives the pair one coefficient (mu_s = mu_k, as a body's
+  // `friction` alone): `friction = 0.0` between rough materials is a frictionless pair
   s.materials[0] = physval::MaterialOverride{"ball", "slope", std::nullopt, 0.0, std::nullopt, std::nullopt};
-  EXPECT_TRUE(has(physval::Feature::StaticFriction));
-  s.materials[0].friction = 0.3;   // raised: mu_s = max(0.2, 0.3) = mu_k
   EXPECT_FALSE(has(physval::Feature::StaticFriction));
+  EXPECT_EQ(physval::combine_materials(s, physval::material_of(s.bodies[0]), physval::material_of("slope", s.walls[0].material))
+                .static_friction,
+            0.0);
+  s.materials[0].friction = 0.1;   // below the bodies' 0.2: mu_s = mu_k = 0.1
+  EXPECT_FALSE(has(physval::Feature::StaticFriction));
+  EXPECT_EQ(physval::combine_materials(s, physval::material_of(s.bodies[0]), physval::material_of("slope", s.walls[0].material))
+                .static_friction,
+            0.1);
+  s.materials[0].static_friction = 0.4;   // both given: mu_s 0.4 > mu_k 0.1
+  EXPECT_TRUE(has(physval::Feature::StaticFriction));
+  s.materials[0].static_friction.reset();
   // rolling friction and friction given only by an override are features too
   s.bodies[0].friction = s.bodies[0].static_friction = 0.0;
   s.walls[0].material.friction = s.walls[0].material.static_friction = 0.0;

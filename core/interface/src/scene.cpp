@@ -63,7 +63,9 @@ PairMaterial combine_materials(const Scene& scene, const MaterialView& a, const 
     if (o.friction) pm.friction = *o.friction;
     if (o.static_friction) pm.static_friction = *o.static_friction;
     if (o.rolling_friction) pm.rolling_friction = *o.rolling_friction;
-    if (o.friction && !o.static_friction) pm.static_friction = std::max(pm.static_friction, *o.friction);
+    // An entry giving `friction` alone gives the pair one coefficient (mu_s = mu_k), as a body
+    // with `friction` alone has: `friction = 0.0` is a frictionless pair.
+    if (o.friction && !o.static_friction) pm.static_friction = *o.friction;
   }
   return pm;
 }
