@@ -672,7 +672,8 @@ def family_junctions():
                         continue
                     v1 = v0 + aA * t1
                     vn, vt = v1 * math.sin(dth), v1 * math.cos(dth)
-                    vt2 = 0.0 if vt <= mus * vn else vt - min(muk * vn, vt)
+                    # the contact slides into the impact: kinetic friction acts through it
+                    vt2 = vt - min(muk * vn, vt)
                     sB, vB = slope_closed_form(thB, mus, muk, vt2, T - t1)
                     p0 = add(pocket, dA, -D)
                     name = "concave_into_%d_%d_%s_%s_%d" % (degA, ddeg, str(mus).replace(".", "p"), str(v0).replace(".", "p"), len(cases))
