@@ -1146,7 +1146,7 @@ class EventLoop {
   // when a condition fails: the caller's collapse decides as before.
   bool zeno_tail(std::uint32_t i, std::uint32_t k, Vec2 n, Vec2 n_resp, const PairMaterial& m, double vn, double an,
                  double t, double t_abs, bool event) {
-    if (!World::zeno_material(m) || !(vn < 0.0) || !(an < 0.0) || n_resp != n) return false;
+    if (!World::zeno_material(m, w_.vel[i], w_.acc[i], n) || !(vn < 0.0) || !(an < 0.0) || n_resp != n) return false;
     if (w_.supported(i) || w_.stationary(i) || !(w_.radius[i] > 0.0) || !(w_.inv_mass[i] > 0.0)) return false;
     if (w_.flags[i] & (kParticle | kPoint | kDestroyOnHit)) return false;
     if (!w_.dep_head.empty() && w_.dep_head[i] != kNone) return false;

@@ -730,7 +730,7 @@ static bool zeno_bounce(World& w, std::uint32_t i, double dt, std::span<const st
   touching_supports(w, i, near, contacts, mu, &rest_e);
   if (contacts.size() != 1 || !(contacts[0].other & kBodySupport)) return false;
   const Segment& s = w.statics.segments[contacts[0].other & ~kBodySupport];
-  if (!World::zeno_material(w.pair_material(w.material[i], s.material))) return false;
+  if (!World::zeno_material(w.pair_material(w.material[i], s.material), w.vel[i], w.acc[i], contacts[0].n)) return false;
   const double vn = dot(w.vel[i], contacts[0].n);
   const double an = dot(w.acc[i], contacts[0].n);
   return an < 0.0 && std::fabs(vn) > 64.0 * 2.220446049250313e-16 * (length(w.vel[i]) + std::fabs(an) * dt);
@@ -1699,7 +1699,7 @@ void detect_support(World& w, std::uint32_t i, const StepContext& ctx) {
     // A frictionless face with 0 < e < 1 met faster than round-off where World::zeno_tails (a
     // step that ends just before a bounce of a Zeno sequence): an impact, whose sequence the
     // event loop ends at its closed-form time (zeno_tail); settled here it stopped early.
-    if (w.zeno_tails() && World::zeno_material(m) && (w.flags[i] & (kParticle | kPoint | kDestroyOnHit)) == 0 &&
+    if (w.zeno_tails() && World::zeno_material(m, w.vel[i], w.acc[i], n) && (w.flags[i] & (kParticle | kPoint | kDestroyOnHit)) == 0 &&
         -vn > 64.0 * 2.220446049250313e-16 * (length(w.vel[i]) + std::fabs(an) * ctx.dt)) {
       continue;
     }

@@ -116,6 +116,19 @@ struct Contact {
   double vscale = 0.0;   // |v_a| + |v_b| before
   double e = 0.0;        // its restitution (0 below the collapse speed)
   bool raised = false;   // target raised to a micro-bounce's minimum separation
+  double slip = 0.0;     // its tangential relative velocity before, where it slides into the set (cone mu_k)
+};
+
+// Contacts that slid into a set, whose slip the set's kinetic-friction answer reversed: they
+// stopped within the impact, and static friction holds them from there (resolve_simultaneous
+// solves the set again with their cone mu_s). Per thread, for the outermost call.
+thread_local std::vector<std::pair<std::uint32_t, std::uint32_t>> t_stuck;
+thread_local int t_depth = 0;
+struct DepthGuard {
+  DepthGuard() {
+    if (t_depth++ == 0) t_stuck.clear();
+  }
+  ~DepthGuard() { --t_depth; }
 };
 
 // Whether bodies i and j touch at t and are closing or at rest; fills the contact.
@@ -234,6 +247,7 @@ bool lone_on_frictionless_faces(World& w, std::uint32_t i, std::uint32_t striker
 bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t,
                           std::vector<std::uint32_t>& bodies, std::vector<BodyPair>& impacted, double seed_min_sep) {
   if (w.impact_law != ImpactLaw::Simultaneous || w.any_rules) return false;
+  const DepthGuard depth_guard;
   const bool face_seed = (j0 & kSegmentContact) != 0;
   // A slow seed impact (below the collapse speed) meets bodies at rest as fixed ones.
   bool fixed_rest = false;
@@ -292,9 +306,19 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       const double wn = dot(vb - va, c.n);
       // A contact that slides when the impact begins slides through it: kinetic friction is
       // its cone (it sticks only where mu_k's impulse stops it); static friction is the cone of
-      // a contact at rest (to round-off of its bodies' speeds). The same law as a lone pair's
-      // impact (collision_response.cpp, friction_change).
-      if (std::fabs(dot(vb - va, perp(c.n))) > 64.0 * 2.220446049250313e-16 * (length(va) + length(vb))) c.mu_s = mu_k;
+      // a contact at rest (to round-off of its bodies' speeds and the seed impact's, set_speed:
+      // a ball at rest against a wall keeps ~1e-16 m/s from an earlier set). The same law as a
+      // lone pair's impact (collision_response.cpp, friction_change). A sliding contact whose
+      // slip the answer reverses stopped within the impact: the set is solved again with its
+      // cone mu_s (t_stuck, below).
+      c.slip = 0.0;
+      const double wt = dot(vb - va, perp(c.n));
+      const bool stuck = std::find(t_stuck.begin(), t_stuck.end(), std::pair{c.a, c.b}) != t_stuck.end();
+      if (mu_k < c.mu_s && !stuck &&
+          std::fabs(wt) > 64.0 * 2.220446049250313e-16 * std::max(length(va) + length(vb), set_speed)) {
+        c.mu_s = mu_k;
+        c.slip = wt;
+      }
       const std::uint32_t other = (c.a & kSegmentContact) ? c.b : c.a;
       const bool slow = (c.a & kSegmentContact) ? -wn < w.collapse_speed(other, c.b) : collapses(w, c.a, c.b, t, -wn);
       const double e = slow ? 0.0 : restitution;
@@ -1419,6 +1443,26 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
   // Snapping at 1024 ulps (~1e-13 of it) instead changed the 50-circle pile at e 0.9 enough
   // to end in a step that gained 0.15 J elsewhere, not understood yet (README, core,
   // Several supports).
+  // A contact that slid into the set with the cone mu_k and leaves it slipping the other way
+  // (beyond round-off) stopped within the impact; static friction holds it from there: the
+  // set is solved again with its cone mu_s (at most 8 times; each adds a contact). A ball
+  // sliding at 1e-9 m/s against the push of a ball striking it at 30 degrees (mu_k 0.2, mu_s
+  // 0.8: tan 30 < mu_s) was slid 0.061 m with mu_k; it stays.
+  if (t_depth < 8) {
+    bool again = false;
+    for (const Contact& c : contacts) {
+      if (c.slip == 0.0) continue;
+      const std::int32_t sa = slot_of(c.a), sb = slot_of(c.b);
+      const Vec2 va = vel(c.a) + (sa >= 0 ? dv[static_cast<std::size_t>(sa)] : Vec2{});
+      const Vec2 vb = vel(c.b) + (sb >= 0 ? dv[static_cast<std::size_t>(sb)] : Vec2{});
+      const double wt = dot(vb - va, perp(c.n));
+      if (wt * c.slip < 0.0 && std::fabs(wt) > 64.0 * kEps * std::max(c.vscale, set_speed)) {
+        t_stuck.emplace_back(c.a, c.b);
+        again = true;
+      }
+    }
+    if (again) return resolve_simultaneous(w, i0, j0, t, bodies, impacted, seed_min_sep);
+  }
   double set_vscale = 0.0;
   for (const Contact& c : contacts) set_vscale = std::max(set_vscale, c.vscale);
   for (std::size_t s = 0; s < bodies.size(); ++s) {

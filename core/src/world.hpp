@@ -386,8 +386,14 @@ struct World {
     return mode == CollisionMode::Exact && !varying_forces && !any_rules && !newtonian && emitters.empty() &&
            (integrator == Integrator::VelocityVerlet || integrator == Integrator::Rk4);
   }
-  static bool zeno_material(const PairMaterial& m) {
-    return m.restitution > 0.0 && m.restitution < 1.0 && !(m.friction > 0.0) && !(m.static_friction > 0.0);
+  // With friction too where the body has no motion along the face (its tangential velocity and
+  // acceleration at round-off of |v| and |a|: a ball dropped straight onto a level floor): no
+  // friction impulse acts at any impact of its tail, and at its end nothing pushes it along.
+  static bool zeno_material(const PairMaterial& m, Vec2 v, Vec2 a, Vec2 n) {
+    if (!(m.restitution > 0.0 && m.restitution < 1.0)) return false;
+    if (!(m.friction > 0.0) && !(m.static_friction > 0.0)) return true;
+    const double eps = 64.0 * 2.220446049250313e-16;
+    return length(v - dot(v, n) * n) <= eps * length(v) && length(a - dot(a, n) * n) <= eps * length(a);
   }
   // Inelastic collapse: an impact of bodies i and j closing slower than this is
   // perfectly inelastic (restitution falls to 0): the rest speed of the larger of their

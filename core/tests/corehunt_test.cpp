@@ -452,5 +452,54 @@ TEST(CoreHunt, AGlancingImpactWithoutKineticFrictionIsFrictionless) {
   }
 }
 
+// A ball b sliding on a floor (mu_k 0.2, mu_s 0.8, e 0) is struck at 30 degrees from above by a
+// frictionless ball a (e 0.5) that pushes it along +x, at the instant b passes x = 0 with slip
+// s (review11). s < 0 (against the push): kinetic friction and the push stop the slip within the
+// impact, and the push then needs a friction ratio of tan 30 deg < mu_s: b sticks, and a leaves
+// as from a fixed ball. s > 0 (along it): the contact slides through the impact with mu_k: the
+// set's closed form (normal impulse P on a-b, floor impulse N = c P, friction mu_k N). A kinetic
+// cone alone slid b 0.061 m at s = -1e-9 (the slip reversed: it stopped); a static cone alone
+// stuck b at s = +1e-6.
+TEST(CoreHunt, AContactSlidingIntoASetSticksOnlyWhereItStops) {
+  const double g = 9.8, r = 0.1, mu_k = 0.2, mu_s = 0.8, e = 0.5, T = 0.3;
+  const double sn = 0.5, c = std::sqrt(3.0) / 2.0;   // the line of centres, 30 degrees off vertical
+  const double drop = 0.2, ti = std::sqrt(2.0 * drop / g), V = g * ti;
+  for (const double slip : {-1e-3, -1e-6, -1e-9, 0.0, 1e-9, 1e-6, 1e-3}) {
+    const double acc = slip > 0.0 ? -mu_k * g : (slip < 0.0 ? mu_k * g : 0.0);   // b's slide before
+    const double v0 = slip - acc * ti, x0 = -(v0 * ti + 0.5 * acc * ti * ti);
+    BodyDef a = circle("a", {-2.0 * r * sn, r + 2.0 * r * c + drop}, {}, r, 1.0, e);
+    BodyDef b = circle("b", {x0, r}, {v0, 0.0}, r, 1.0, e);
+    b.friction = mu_k;
+    b.static_friction = mu_s;
+    Scene s = scene_of({a, b}, {wall("floor", {-5.0, 0.0}, {5.0, 0.0}, 0.0, mu_k, mu_s)}, {0.0, -g});
+    MaterialOverride ab = pair_friction("a", "b", 0.0);
+    s.materials.push_back(ab);
+    SCOPED_TRACE("slip " + std::to_string(slip));
+    Sim sim(s);
+    sim.run_until(T, 1.0 / 240.0);
+    EXPECT_EQ(sim.engine.broken_guarantee(), "");
+    EXPECT_TRUE(sim.engine.limits_hit().empty());
+    const BodyState sa = sim.state("a"), sb = sim.state("b");
+    const double vn = c * V - sn * slip;   // closing speed along n = (sn, -c), from a to b
+    double ub, Pa;                          // b's speed after the impact; the a-b impulse
+    if (slip > 0.0) {
+      // b's vertical speed stays 0 (N = c P), the relative normal speed becomes -e times it.
+      Pa = (1.0 + e) * vn / (2.0 - c * (sn * mu_k + c));
+      ub = slip + Pa * (sn - mu_k * c);
+    } else {
+      Pa = c * V + e * vn;   // b stopped and held: a leaves at e times the closing speed
+      ub = 0.0;
+    }
+    // Tolerance 1e-8: b rests on the floor within core's hold tolerance (1e-9 of the scale),
+    // which moves the impact's time by up to ~1e-9 m / (c V) and a's speed by g times that.
+    const double tb = T - ti;
+    const double stop = ub > 0.0 ? std::min(tb, ub / (mu_k * g)) : 0.0;
+    EXPECT_NEAR(sb.position.x, ub * stop - 0.5 * mu_k * g * stop * stop, 1e-8);
+    EXPECT_NEAR(sb.velocity.x, ub - mu_k * g * stop, 1e-8);
+    EXPECT_NEAR(sa.velocity.x, -Pa * sn, 1e-8);
+    EXPECT_NEAR(sa.velocity.y, -V + Pa * c - g * tb, 1e-8);
+  }
+}
+
 }  // namespace
 }  // namespace physval::test
