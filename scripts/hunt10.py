@@ -23,6 +23,9 @@ Families:
   impactstick  a ball dropped with a horizontal speed onto a floor with mu_s > mu_k (core only):
                the contact slides through the impact, so kinetic friction acts (core stuck it
                whenever u <= mu_s (1 + e) v_n; fixed).
+  setstick     a ball sliding on a floor struck by a frictionless ball at 10-60 degrees (a
+               simultaneous set), slip -1e-3..1e-3 m/s against or along the push: static
+               friction holds it only where the slip stops and tan th <= mu_s (closed forms).
   faroff       a bounce and a head-on pair moved up to 1e7 m from the origin, negative too, on
                core's broad phases: the same closed forms.
 
@@ -450,6 +453,79 @@ static_friction = {fmt(mus)}
             truth[name] = dict(final={"ball": ((x, y), (u2, vy - G_ * t2))}, exact=True, scale=max(1.0, x))
 
 
+# ---------------------------------------------------------------- setstick
+def gen_setstick(out, truth, quick):
+    """A ball b sliding on a floor (e 0) with slip s at x = 0 is struck there by a frictionless
+    ball a (e 0.5) dropped 0.2 m, its line of centres th off vertical, pushing b along +x: a
+    simultaneous set (a-b and b-floor). s <= 0 (against the push, or at rest): the slip stops
+    within the impact and static friction holds b where tan th <= mu_s (a leaves as from a fixed
+    ball, P = c V + e v_n); otherwise b slides along the push with kinetic friction (the set's
+    closed form: floor impulse N = c P, friction mu_k N, P = (1 + e) v_n / (2 - c (c + mu_k s))).
+    A slip against the push larger than 1e-9 m/s with tan th > mu_s is left out (its stopping
+    phase is not in this closed form). Core only where mu_s > mu_k."""
+    G_, r, e, T, drop = G, 0.1, 0.5, 0.3, 0.2
+    ti = math.sqrt(2 * drop / G_)
+    V = G_ * ti
+    for deg in ([30, 60] if quick else [10, 20, 30, 40, 45, 50, 60]):
+        th = math.radians(deg)
+        sn, c = math.sin(th), math.cos(th)
+        for (muk, mus) in ([(0.2, 0.8)] if quick else [(0.2, 0.8), (0.0, 0.5), (0.3, 0.3), (0.5, 1.2)]):
+            for slip in ([-1e-9, 1e-6] if quick else [-1e-3, -1e-9, 0.0, 1e-9, 1e-3]):
+                acc = -muk * G_ if slip > 0 else (muk * G_ if slip < 0 else 0.0)
+                v0 = slip - acc * ti
+                x0 = -(v0 * ti + 0.5 * acc * ti * ti)
+                vn = c * V - sn * slip
+                if slip <= 0 and math.tan(th) <= mus:
+                    P, ub = c * V + e * vn, 0.0
+                else:
+                    if slip < -1e-9:
+                        continue
+                    P = (1 + e) * vn / (2 - c * (c + muk * sn))
+                    ub = max(slip, 0.0) + P * (sn - muk * c)
+                    if ub <= 0:
+                        continue
+                tb = T - ti
+                stop = (min(tb, ub / (muk * G_)) if muk > 0 else tb) if ub > 0 else 0.0
+                xb, vb = ub * stop - 0.5 * muk * G_ * stop * stop, ub - muk * G_ * stop
+                va = (-P * sn, -V + P * c - G_ * tb)
+                xa = (-2 * r * sn + va[0] * tb, r + 2 * r * c + (-V + P * c) * tb - 0.5 * G_ * tb * tb)
+                name = f"setstick_th{deg}_muk{ident(muk)}_mus{ident(mus)}_s{'m' if slip < 0 else ''}{ident(abs(slip))}"
+                write(out, name, f"""name = "{name}"
+duration = {fmt(T)}
+dt = "1/240"
+[world]
+gravity = [0.0, {fmt(-G_)}]
+[[bodies]]
+name = "a"
+radius = {fmt(r)}
+position = [{fmt(-2 * r * sn)}, {fmt(r + 2 * r * c + drop)}]
+restitution = {fmt(e)}
+[[bodies]]
+name = "b"
+radius = {fmt(r)}
+position = [{fmt(x0)}, {fmt(r)}]
+velocity = [{fmt(v0)}, 0.0]
+restitution = {fmt(e)}
+friction = {fmt(muk)}
+static_friction = {fmt(mus)}
+[[walls]]
+name = "floor"
+from = [-5.0, 0.0]
+to = [5.0, 0.0]
+restitution = 0.0
+friction = {fmt(muk)}
+static_friction = {fmt(mus)}
+[[materials]]
+a = "a"
+b = "b"
+friction = 0.0
+""")
+                final = {"b": ((xb, r), (vb, 0.0))}
+                if xa[1] > 1.5 * r:   # a still in flight at the end (else it met the floor: not judged)
+                    final["a"] = (xa, va)
+                truth[name] = dict(final=final, exact=True, scale=1.0)
+
+
 # ---------------------------------------------------------------- faroff
 def gen_faroff(out, truth, quick):
     """A ball dropped 1 m onto a floor (e 0.5) and a head-on elastic pair, the whole scene moved
@@ -543,7 +619,7 @@ def judge_extra(name, t, runs, ref, out, find, conserve_rule):
 
 FAMILIES = {"orbitgraze": gen_orbitgraze, "soft": gen_soft, "superelastic": gen_superelastic,
             "matstatic": gen_matstatic, "matzero": gen_matzero, "impactstick": gen_impactstick,
-            "faroff": gen_faroff}
+            "setstick": gen_setstick, "faroff": gen_faroff}
 OPEN = set()   # impactstick was open until core took kinetic friction through an impact
 
 
