@@ -36,7 +36,7 @@ error; no engine may be `ok` with its position_divergence below half its miss of
 form (a miss above 2% of the size); a core run in a family it is exact in must meet the closed
 form. Exit 1 when any finding, 0 when none, 2 on a usage error.
 """
-import json, math, os, subprocess, sys
+import math, os, sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import hunt8  # noqa: E402
@@ -620,84 +620,18 @@ def judge_extra(name, t, runs, ref, out, find, conserve_rule):
 FAMILIES = {"orbitgraze": gen_orbitgraze, "soft": gen_soft, "superelastic": gen_superelastic,
             "matstatic": gen_matstatic, "matzero": gen_matzero, "impactstick": gen_impactstick,
             "setstick": gen_setstick, "faroff": gen_faroff}
-OPEN = set()   # impactstick was open until core took kinetic friction through an impact
+
+
+def judge_one(name, t, runs, ref, res_dir, find):
+    if t["final"] and "offset" in t:
+        judge_offset(name, t, runs, ref, res_dir, find)
+    elif t["final"]:
+        hunt8.judge(name, t, runs, ref, res_dir, find)
+    judge_extra(name, t, runs, ref, res_dir, find, None)
 
 
 def main(argv):
-    build, work, fams, jobs, quick = "build", "/tmp/hunt10", None, 2, False
-    pos = []
-    i = 0
-    while i < len(argv):
-        a = argv[i]
-        if a in ("--family", "-j") and i + 1 < len(argv):
-            if a == "--family":
-                fams = argv[i + 1].split(",")
-            else:
-                jobs = int(argv[i + 1])
-            i += 2
-            continue
-        if a == "--quick":
-            quick = True
-        elif a.startswith("-"):
-            print(__doc__)
-            return 2
-        else:
-            pos.append(a)
-        i += 1
-    if fams is None:   # --quick leaves out impactstick: core's impact law there is an open finding
-        fams = [f for f in FAMILIES if not (quick and f in OPEN)]
-    if pos:
-        build = pos[0]
-    if len(pos) > 1:
-        work = pos[1]
-    for f in fams:
-        if f not in FAMILIES:
-            print(f"unknown family {f}; one of {', '.join(FAMILIES)}", file=sys.stderr)
-            return 2
-    physval = os.path.join(build, "physval")
-    findings = []
-
-    def find(scen, engine, what):
-        findings.append((scen, engine, what))
-
-    total_runs = 0
-    for fam in fams:
-        out = os.path.join(work, fam)
-        scenes = os.path.join(out, "scenes")
-        os.makedirs(scenes, exist_ok=True)
-        for f in os.listdir(scenes):
-            os.remove(os.path.join(scenes, f))
-        truth = {}
-        FAMILIES[fam](scenes, truth, quick)
-        res_dir = os.path.join(out, "out")
-        p = subprocess.run([physval, "run", scenes, "--out", res_dir, "-j", str(jobs), "--no-cache"],
-                           stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-        if p.returncode not in (0, 1):
-            print(f"{fam}: physval run exited {p.returncode}: {p.stderr[-400:]}", file=sys.stderr)
-            return 2
-        data = json.load(open(os.path.join(res_dir, "results.json")))
-        by, refs = {}, {x["scenario"]: x for x in data.get("references", [])}
-        for r in data["runs"]:
-            by.setdefault(r["scenario"], []).append(r)
-            total_runs += 1
-        n0 = len(findings)
-        for name, t in truth.items():
-            if name not in by:
-                find(name, "-", "no runs")
-                continue
-            if t["final"] and "offset" in t:
-                judge_offset(name, t, by[name], refs.get(name, {}), res_dir, find)
-            elif t["final"]:
-                hunt8.judge(name, t, by[name], refs.get(name, {}), res_dir, find)
-            judge_extra(name, t, by[name], refs.get(name, {}), res_dir, find, None)
-        print(f"{fam}: {len(truth)} scenes, {sum(len(by[n]) for n in by)} runs, {len(findings) - n0} findings", flush=True)
-    for scen, engine, what in findings:
-        print(f"FINDING {scen} [{engine}]: {what}")
-    for n in NOTES:
-        print(f"note {n}")
-    print(f"hunt10: {total_runs} runs, {len(findings)} findings, {len(NOTES)} notes")
-    return 1 if findings else 0
-
+    return hunt8.run_hunt("hunt10", __doc__, FAMILIES, judge_one, argv)
 
 if __name__ == "__main__":
     sys.exit(main(sys.argv[1:]))

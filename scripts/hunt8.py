@@ -780,8 +780,12 @@ FAMILIES = {"thrustfloor": gen_thrustfloor, "thrustslope": gen_thrustslope, "win
             "scale": gen_scale, "hugedt": gen_hugedt, "sliver": gen_sliver, "boxcorner": gen_boxcorner, "ledge": gen_ledge, "zeno": gen_zeno}
 
 
-def main(argv):
-    build, work, fams, jobs, quick = "build", "/tmp/hunt8", list(FAMILIES), 2, False
+def run_hunt(tag, doc, families, judge_one, argv):
+    """The command line shared by the hunts (hunt8.py, hunt10.py): parses
+    [BUILD_DIR] [WORKDIR] [--family F,...] [-j N] [--quick], writes each family's scenes, runs
+    physval on them, calls judge_one(name, truth, runs, reference, results_dir, find) per scene
+    and prints the findings. Exit 1 when any finding, 0 when none, 2 on a usage error."""
+    build, work, fams, jobs, quick = "build", "/tmp/" + tag, list(families), 2, False
     pos = []
     i = 0
     while i < len(argv):
@@ -796,7 +800,7 @@ def main(argv):
         if a == "--quick":
             quick = True
         elif a.startswith("-"):
-            print(__doc__)
+            print(doc)
             return 2
         else:
             pos.append(a)
@@ -806,8 +810,8 @@ def main(argv):
     if len(pos) > 1:
         work = pos[1]
     for f in fams:
-        if f not in FAMILIES:
-            print(f"unknown family {f}; one of {', '.join(FAMILIES)}", file=sys.stderr)
+        if f not in families:
+            print(f"unknown family {f}; one of {', '.join(families)}", file=sys.stderr)
             return 2
     physval = os.path.join(build, "physval")
     findings = []
@@ -823,7 +827,7 @@ def main(argv):
         for f in os.listdir(scenes):
             os.remove(os.path.join(scenes, f))
         truth = {}
-        FAMILIES[fam](scenes, truth, quick)
+        families[fam](scenes, truth, quick)
         res_dir = os.path.join(out, "out")
         p = subprocess.run([physval, "run", scenes, "--out", res_dir, "-j", str(jobs), "--no-cache"],
                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
@@ -840,15 +844,19 @@ def main(argv):
             if name not in by:
                 find(name, "-", "no runs")
                 continue
-            judge(name, t, by[name], refs.get(name, {}), res_dir, find)
+            judge_one(name, t, by[name], refs.get(name, {}), res_dir, find)
         print(f"{fam}: {len(truth)} scenes, {sum(len(by[n]) for n in by)} runs, {len(findings) - n0} findings", flush=True)
     for scen, engine, what in findings:
         print(f"FINDING {scen} [{engine}]: {what}")
     for n in NOTES:
         print(f"note {n}")
-    print(f"hunt8: {total_runs} runs, {len(findings)} findings, {len(NOTES)} notes")
+    print(f"{tag}: {total_runs} runs, {len(findings)} findings, {len(NOTES)} notes")
     return 1 if findings else 0
 
+
+
+def main(argv):
+    return run_hunt("hunt8", __doc__, FAMILIES, judge, argv)
 
 if __name__ == "__main__":
     sys.exit(main(sys.argv[1:]))
