@@ -40,7 +40,7 @@ import math, os, sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import hunt8  # noqa: E402
-from hunt8 import fmt, vec, ident, write, NOTES, G0 as G  # noqa: E402
+from hunt8 import fmt, vec, ident, write, G0 as G  # noqa: E402
 
 
 # ---------------------------------------------------------------- Kepler
