@@ -78,6 +78,70 @@ TEST(NumberText, EqualsToCharsForEveryLayoutAndDigitCount) {
   }
 }
 
+// to_chars_g<P> (the series' body positions, P = 9 by default) against std::to_chars(general,
+// P) for every P of the fast path: layouts, decades, neighbours, random values, P-digit ties.
+template <int P>
+void expect_g_equals_to_chars() {
+  const auto ref = [](double v) {
+    char buf[64];
+    return std::string(buf, std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, P).ptr);
+  };
+  const auto fast = [](double v) {
+    char buf[64];
+    return std::string(buf, physval::to_chars_g<P>(buf, buf + sizeof buf, v));
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  for (int exp10 = -7; exp10 <= P + 1; ++exp10) {
+    for (const double mant : {1.0, 9.999999999999, 9.99999999, 5.0, 1.2345678901234, 9.5, 2.5, 4.4999999999}) {
+      const double v = mant * std::pow(10.0, exp10);
+      for (const double w : {v, -v, std::nextafter(v, 0.0), std::nextafter(v, inf)}) {
+        ASSERT_EQ(fast(w), ref(w)) << "P=" << P << " " << std::hexfloat << w;
+      }
+    }
+  }
+  std::mt19937_64 rng(static_cast<std::uint64_t>(P) * 7919u);
+  std::uniform_real_distribution<double> unit(-3.0, 3.0);
+  std::uniform_int_distribution<int> decade(-8, 13);
+  const double scale = std::pow(10.0, P - 1);
+  for (int i = 0; i < 60000; ++i) {
+    double v = 0.0;
+    switch (i % 4) {
+      case 0: v = unit(rng); break;
+      case 1: v = unit(rng) * std::pow(10.0, decade(rng)); break;
+      case 2: v = (std::round(unit(rng) * scale) + 0.5) / scale; break;   // near a P-digit tie
+      default: {
+        const std::uint64_t b = rng();
+        std::memcpy(&v, &b, sizeof v);
+        break;
+      }
+    }
+    ASSERT_EQ(fast(v), ref(v)) << "P=" << P << " " << std::hexfloat << v;
+  }
+  // Exact decimal ties: m / 2^j ends in a 5 at its j-th decimal, so with P + 1 significant
+  // digits it lies exactly between two P-digit texts (std::to_chars rounds it to even).
+  for (int j = 1; j <= 12; ++j) {
+    for (std::uint64_t m = 1; m < 4000; m += 2) {
+      const double v = std::ldexp(static_cast<double>(m), -j);
+      for (const double w : {v, -v, v * 1024.0}) ASSERT_EQ(fast(w), ref(w)) << "P=" << P << " " << std::hexfloat << w;
+    }
+  }
+}
+
+TEST(NumberText, FewerDigitsEqualToCharsForEveryDigitCount) {
+  expect_g_equals_to_chars<1>();
+  expect_g_equals_to_chars<2>();
+  expect_g_equals_to_chars<3>();
+  expect_g_equals_to_chars<4>();
+  expect_g_equals_to_chars<5>();
+  expect_g_equals_to_chars<6>();
+  expect_g_equals_to_chars<7>();
+  expect_g_equals_to_chars<8>();
+  expect_g_equals_to_chars<9>();
+  expect_g_equals_to_chars<10>();
+  expect_g_equals_to_chars<11>();
+  expect_g_equals_to_chars<12>();
+}
+
 }  // namespace
 
 // results.json's contacts are written as text, not through a json tree: the text must be
@@ -113,6 +177,72 @@ TEST(NumberText, StreamedContactsAreTheTreesDumpForOddNamesAndTimes) {
   nlohmann::json tree = physval::suite_to_json(result);
   tree["context"] = nlohmann::json::parse(streamed.str())["context"];
   EXPECT_EQ(streamed.str(), tree.dump(2) + "\n");
+}
+
+}  // namespace
+
+// The series CSV: t and the totals with 12 significant digits, the body positions with the
+// digits asked (9 by default; 17 writes every double exactly, totals too); nan for a body
+// not alive. What the report and gnuplot read is the same columns either way.
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
+
+namespace {
+
+std::vector<std::string> series_row(const std::filesystem::path& file, std::size_t row) {
+  std::ifstream in(file);
+  std::string line;
+  for (std::size_t i = 0; i <= row; ++i) std::getline(in, line);
+  std::vector<std::string> cells;
+  std::stringstream ss(line);
+  for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+  return cells;
+}
+
+TEST(NumberText, SeriesPositionsGetTheDigitsAskedTotalsTwelve) {
+  physval::SuiteResult result;
+  physval::ScenarioResult sr;
+  sr.scene.name = "digits";
+  physval::RunRecord r;
+  r.scenario = "digits";
+  r.engine = "core";
+  r.bodies = {physval::BodyMeta{}, physval::BodyMeta{}};
+  r.bodies[0].name = "a";
+  r.bodies[1].name = "b";
+  const double x = 1.0 / 3.0, y = -2.0 / 3.0, e = 12.345678901234567, t = 0.1;
+  r.series.time = {t};
+  physval::Totals tot;
+  tot.kinetic = e;
+  r.series.totals = {tot};
+  r.series.states = {physval::SampleRow{physval::SampleState({x, y}, true), physval::SampleState({x, y}, false)}};
+  sr.runs.push_back(r);
+  result.scenarios.push_back(sr);
+  const auto dir = std::filesystem::temp_directory_path() / ("physval-digits-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  physval::write_results(dir / "default", result);
+  auto cells = series_row(dir / "default" / "series" / "digits" / "core.csv", 1);
+  ASSERT_EQ(cells.size(), 11u);
+  EXPECT_EQ(cells[0], "0.1");
+  EXPECT_EQ(cells[2], "12.3456789012");   // kinetic: 12 digits
+  EXPECT_EQ(cells[7], "0.333333333");     // x_a: 9
+  EXPECT_EQ(cells[8], "-0.666666667");
+  EXPECT_EQ(cells[9], "nan");
+  EXPECT_EQ(cells[10], "nan");
+  physval::write_results(dir / "twelve", result, 12);
+  cells = series_row(dir / "twelve" / "series" / "digits" / "core.csv", 1);
+  EXPECT_EQ(cells[7], "0.333333333333");
+  EXPECT_EQ(cells[8], "-0.666666666667");
+  physval::write_results(dir / "full", result, 17);
+  cells = series_row(dir / "full" / "series" / "digits" / "core.csv", 1);
+  EXPECT_EQ(std::stod(cells[7]), x);   // every double back exactly
+  EXPECT_EQ(std::stod(cells[8]), y);
+  EXPECT_EQ(std::stod(cells[2]), e);
+  EXPECT_EQ(std::stod(cells[0]), t);
+  EXPECT_THROW(physval::write_results(dir / "bad", result, 0), std::invalid_argument);
+  EXPECT_THROW(physval::write_results(dir / "bad", result, 18), std::invalid_argument);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
