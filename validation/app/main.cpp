@@ -67,7 +67,6 @@ struct CommonOptions {
   std::vector<std::string> engines;
   std::string out = "physval-out";
   std::string overhead;   // --overhead FILE
-  int series_digits = kDefaultSeriesDigits;   // --series-digits N
   std::string dt;
   std::string duration;
   bool no_isolate = false;
@@ -118,11 +117,6 @@ void add_common(CLI::App* cmd, CommonOptions& o) {
   cmd->add_option("--overhead", o.overhead,
                   "also write here (JSON) the harness's CPU per scenario next to the engines' stepping "
                   "(scripts/overhead.sh prints it as a table)");
-  cmd->add_option("--series-digits", o.series_digits,
-                  "significant digits of the body positions in series/*.csv (1-17; 17: every double exactly, "
-                  "and t and the totals too; they get 12 otherwise)")
-      ->check(CLI::Range(1, 17))
-      ->capture_default_str();
   add_plugin_option(cmd, o.plugins);
   cmd->add_option("-j,--jobs", o.jobs, "references and engine runs at once (default 0: every core); results do not depend on it");
   cmd->add_option("--shard", o.shard,
@@ -342,7 +336,7 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
   }
   try {
     // Everything goes into the staging folder, which then replaces --out whole.
-    write_results(out->staging(), result, o.series_digits);
+    write_results(out->staging(), result);
     bool report_written = false;
     if (report) {
       try {

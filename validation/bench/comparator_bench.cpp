@@ -5,8 +5,8 @@
 #include <unistd.h>
 
 #include <charconv>
-#include <filesystem>
 #include <cmath>
+#include <filesystem>
 #include <random>
 
 #include "physval/validation/comparator.hpp"
@@ -249,21 +249,18 @@ BENCHMARK(BM_ContainmentObserveTwoPoints)->Unit(benchmark::kNanosecond);
 // The series CSVs' number text (results_json.cpp writes six CSVs of up to 807 columns a
 // sample; on circle_gas that was a third of the harness): 4096 positions of a gas (full
 // 17-digit doubles in +-3.5 m, a few energies and momenta), each as %.12g and a comma.
-// range(0) = 0: std::to_chars(general, 12); 1: to_chars_g12 (the same bytes); 2: to_chars_g<9>
-// (the body positions' default since the eleventh overhead pass).
+// range(0) = 0: std::to_chars(general, 12); 1: to_chars_g12 (the same bytes).
 void BM_SeriesNumberText(benchmark::State& state) {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> position(-3.5, 3.5), energy(10.0, 200.0);
   std::vector<double> values(4096);
   for (std::size_t i = 0; i < values.size(); ++i) values[i] = i % 64 == 0 ? energy(rng) : position(rng);
   std::vector<char> buffer(values.size() * 33);
-  const auto mode = state.range(0);
+  const bool fast = state.range(0) == 1;
   for (auto _ : state) {
     char* o = buffer.data();
     for (const double v : values) {
-      o = mode == 2   ? to_chars_g<9>(o, o + 32, v)
-          : mode == 1 ? to_chars_g12(o, o + 32, v)
-                      : std::to_chars(o, o + 32, v, std::chars_format::general, 12).ptr;
+      o = fast ? to_chars_g12(o, o + 32, v) : std::to_chars(o, o + 32, v, std::chars_format::general, 12).ptr;
       *o++ = ',';
     }
     benchmark::DoNotOptimize(o);
@@ -271,14 +268,14 @@ void BM_SeriesNumberText(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(values.size()));
 }
-BENCHMARK(BM_SeriesNumberText)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SeriesNumberText)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 // write_results on circle_gas's shape (one scenario, five engine runs and a reference of 200
-// bodies x 301 samples, positions in +-1.1 m), into a folder under $TMPDIR: the series' text
-// and the kernel's copy of it into the page cache (CPU time counts the system time too).
-// range(0): the body positions' significant digits (12: before the eleventh pass; 9: default).
+// bodies x 301 samples, positions in +-1.1 m), into a fresh folder under $TMPDIR: the series'
+// text, the files' creation and the kernel's copy into the page cache (CPU time counts the
+// system time). perf of it (README "Harness overhead", eleventh pass): the number text about
+// two thirds, the kernel's copy 2-3%.
 void BM_WriteSeriesGas(benchmark::State& state) {
-  const int digits = static_cast<int>(state.range(0));
   SuiteResult suite;
   ScenarioResult sr;
   sr.scene.name = "gas";
@@ -314,11 +311,11 @@ void BM_WriteSeriesGas(benchmark::State& state) {
     state.PauseTiming();
     std::filesystem::remove_all(dir);
     state.ResumeTiming();
-    write_results(dir / std::to_string(n++ % 2), suite, digits);
+    write_results(dir / std::to_string(n++ % 2), suite);
   }
   std::filesystem::remove_all(dir);
 }
-BENCHMARK(BM_WriteSeriesGas)->Arg(12)->Arg(9)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_WriteSeriesGas)->Unit(benchmark::kMillisecond);
 
 // The stepping loop's own cost a step (runner.cpp: the clock, the clock check, reading the
 // motion, containment, the sample countdown): run_engine on an engine whose step() does

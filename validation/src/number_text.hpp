@@ -1,4 +1,4 @@
-// %.12g text of a double (what std::to_chars(general, 12) gives; to_chars_g<P>: %.Pg), byte for byte, about
+// %.12g text of a double (what std::to_chars(general, 12) gives), byte for byte, about
 // three times as fast (BM_SeriesNumberText) for the magnitudes series hold (1e-5 <= |v| < 1e11): the 12 digits come
 // from exact integer arithmetic (the mantissa times a power of ten in 128 bits, rounded
 // to nearest); exact ties, other magnitudes, zero, NaN and infinities go to std::to_chars.
@@ -17,16 +17,10 @@ namespace physval {
 // __extension__ says so to -Wpedantic.
 __extension__ typedef unsigned __int128 uint128_for_text;
 
-// %.Pg for P significant digits, 1 <= P <= 12: the same arithmetic rounded to P digits (the
-// series' body positions use P = 9 by default, README "Output"); P = 12 is to_chars_g12.
-template <int P>
-[[gnu::always_inline]] inline char* to_chars_g(char* out, char* end, double v) {
-  static_assert(P >= 1 && P <= 12, "the fast path holds at most 12 digits");
-  auto slow = [&] { return std::to_chars(out, end, v, std::chars_format::general, P).ptr; };
+[[gnu::always_inline]] inline char* to_chars_g12(char* out, char* end, double v) {
+  auto slow = [&] { return std::to_chars(out, end, v, std::chars_format::general, 12).ptr; };
   const double a = std::fabs(v);
-  constexpr double kFixedBelow = P == 1 ? 1.0 : P == 2 ? 1e1 : P == 3 ? 1e2 : P == 4 ? 1e3 : P == 5 ? 1e4 : P == 6 ? 1e5 : P == 7 ? 1e6 : P == 8 ? 1e7 : P == 9 ? 1e8 : P == 10 ? 1e9 : P == 11 ? 1e10 : 1e11;
-  // Below 10^(P-1), %.Pg is fixed notation (its exponent stays below P even when rounded up).
-  if (!(a >= 1e-5 && a < kFixedBelow)) return slow();   // also NaN, 0 and infinities
+  if (!(a >= 1e-5 && a < 1e11)) return slow();   // also NaN, 0 and infinities
   std::uint64_t bits;
   std::memcpy(&bits, &v, sizeof bits);
   const int biased = static_cast<int>((bits >> 52) & 0x7ff);
@@ -43,7 +37,7 @@ template <int P>
   std::uint64_t n = 0;
   for (int attempt = 0;; ++attempt) {
     if (attempt == 3) return slow();
-    const int k = P - 1 - exp10;              // n = round(|v| * 10^k), P digits
+    const int k = 11 - exp10;                 // n = round(|v| * 10^k), 12 digits
     if (k < 0 || k > 17 || -e >= 127) return slow();
     // First in double: 10^k (k <= 17 < 23) is exact, so y is |v| 10^k to within half an ulp
     // of y. Kept only for y < 10^12 < 2^40 (half an ulp 2^-14 at most; a larger y, up to
@@ -56,11 +50,11 @@ template <int P>
       const auto whole = static_cast<std::uint64_t>(y);
       if (std::fabs((y - static_cast<double>(whole)) - 0.5) > 0x1p-12) {
         n = static_cast<std::uint64_t>(y + 0.5);
-        if (n >= kPow10[P]) {
+        if (n >= kPow10[12]) {
           ++exp10;
           continue;
         }
-        if (n < kPow10[P - 1]) {
+        if (n < kPow10[11]) {
           --exp10;
           continue;
         }
@@ -75,16 +69,16 @@ template <int P>
     const uint128_for_text half = static_cast<uint128_for_text>(1) << (shift - 1);
     if (rem == half) return slow();           // an exact tie: leave the rounding rule to to_chars
     n = static_cast<std::uint64_t>(q) + (rem > half ? 1 : 0);
-    if (n >= kPow10[P]) {
-      if (n == kPow10[P] && static_cast<std::uint64_t>(q) < kPow10[P]) {   // rounded up to 10^P
-        n = kPow10[P - 1];
+    if (n >= kPow10[12]) {
+      if (n == kPow10[12] && static_cast<std::uint64_t>(q) < kPow10[12]) {   // rounded up to 10^12
+        n = kPow10[11];
         ++exp10;
         break;
       }
       ++exp10;
       continue;
     }
-    if (n < kPow10[P - 1]) {
+    if (n < kPow10[11]) {
       --exp10;
       continue;
     }
@@ -99,7 +93,6 @@ template <int P>
       "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
       "8081828384858687888990919293949596979899";
   if constexpr (std::endian::native != std::endian::little) return slow();
-  n *= kPow10[12 - P];   // the P digits then 12 - P zeros, which the count below leaves out
   const auto pair = [&](std::uint32_t x) {
     std::uint16_t p;
     std::memcpy(&p, kTwoDigits + 2 * x, 2);
@@ -154,7 +147,5 @@ template <int P>
   }
   return o;
 }
-
-[[gnu::always_inline]] inline char* to_chars_g12(char* out, char* end, double v) { return to_chars_g<12>(out, end, v); }
 
 }  // namespace physval

@@ -349,10 +349,7 @@ void write_whole_file(const std::filesystem::path& path, std::string_view text) 
 
 }  // namespace
 
-void write_results(const std::filesystem::path& dir, const SuiteResult& result, int position_digits) {
-  if (position_digits < 1 || position_digits > 17) {
-    throw std::invalid_argument("series digits must be 1 to 17, not " + std::to_string(position_digits));
-  }
+void write_results(const std::filesystem::path& dir, const SuiteResult& result) {
   // Series first: results.json, written last, is what marks a complete output. The
   // report's scene player draws every body, so the series hold up to this many.
   constexpr std::size_t kMaxBodiesInSeries = 400;
@@ -385,62 +382,39 @@ void write_results(const std::filesystem::path& dir, const SuiteResult& result, 
       }
       std::memcpy(buffer.get(), header.data(), header.size());
       char* o = buffer.get() + header.size();
-      // t and the totals: 12 digits (more when the positions get more); the positions:
-      // position_digits, 9 by default (a fifth fewer bytes than 12 on a gas, where the
-      // kernel's copy of the text into the page cache costs as much as making it).
-      // The rows, for one way of writing the totals and one of the positions (each a lambda
-      // of its own, so that the loop is made once for each pair and the text inlined).
-      auto rows = [&](auto put, auto put_position) {
-        for (std::size_t k = 0; k < r.series.time.size(); ++k) {
-          const Totals& t = r.series.totals[k];
-          put(r.series.time[k]);
-          for (const double v : {t.energy(), t.kinetic, t.potential, t.momentum.x, t.momentum.y, t.angular_momentum}) {
+      auto put = [&](double v) {
+        if (std::isnan(v)) {
+          std::memcpy(o, "nan", 3);
+          o += 3;
+          return;
+        }
+        o = to_chars_g12(o, o + kMaxNumber, v);
+      };
+      for (std::size_t k = 0; k < r.series.time.size(); ++k) {
+        const Totals& t = r.series.totals[k];
+        put(r.series.time[k]);
+        for (const double v : {t.energy(), t.kinetic, t.potential, t.momentum.x, t.momentum.y, t.angular_momentum}) {
+          *o++ = ',';
+          put(v);
+        }
+        const auto& st = r.series.states[k];
+        const std::size_t have = std::min(nb, st.size());
+        for (std::size_t i = 0; i < have; ++i) {
+          if (st[i].alive) {
             *o++ = ',';
-            put(v);
-          }
-          const auto& st = r.series.states[k];
-          const std::size_t have = std::min(nb, st.size());
-          for (std::size_t i = 0; i < have; ++i) {
-            if (st[i].alive) {
-              *o++ = ',';
-              put_position(st[i].position.x);
-              *o++ = ',';
-              put_position(st[i].position.y);
-            } else {
-              std::memcpy(o, ",nan,nan", 8);
-              o += 8;
-            }
-          }
-          for (std::size_t i = have; i < nb; ++i) {
+            put(st[i].position.x);
+            *o++ = ',';
+            put(st[i].position.y);
+          } else {
             std::memcpy(o, ",nan,nan", 8);
             o += 8;
           }
-          *o++ = '\n';
         }
-      };
-      auto nan_or = [&](double v) {
-        if (!std::isnan(v)) return false;
-        std::memcpy(o, "nan", 3);
-        o += 3;
-        return true;
-      };
-      const auto g12 = [&](double v) {
-        if (!nan_or(v)) o = to_chars_g<12>(o, o + kMaxNumber, v);
-      };
-      const auto g9 = [&](double v) {
-        if (!nan_or(v)) o = to_chars_g<9>(o, o + kMaxNumber, v);
-      };
-      const auto any = [&](double v) {   // --series-digits other than 9 and 12: t and totals too when > 12
-        if (!nan_or(v)) o = std::to_chars(o, o + kMaxNumber, v, std::chars_format::general, position_digits).ptr;
-      };
-      if (position_digits == 9) {
-        rows(g12, g9);
-      } else if (position_digits == 12) {
-        rows(g12, g12);
-      } else if (position_digits < 12) {
-        rows(g12, any);
-      } else {
-        rows(any, any);
+        for (std::size_t i = have; i < nb; ++i) {
+          std::memcpy(o, ",nan,nan", 8);
+          o += 8;
+        }
+        *o++ = '\n';
       }
       write_whole_file(folder / (safe_file_name(label) + ".csv"),
                        std::string_view(buffer.get(), static_cast<std::size_t>(o - buffer.get())));

@@ -55,12 +55,7 @@ class StagedOutputFolder {
 
 // DIR/results.json, plus DIR/series/<scenario>/<engine>.csv (time series for plots:
 // t, energy, kinetic, potential, px, py, angular_momentum, then x_i, y_i of each body).
-// The body positions x_i, y_i are written with `position_digits` significant digits (%.Ng,
-// 1 to 17; default 9: a float32 engine's positions exactly, 1e-9 relative otherwise); t and
-// the totals with 12, or position_digits when more (17: every double exactly). README "Output".
-constexpr int kDefaultSeriesDigits = 9;
-void write_results(const std::filesystem::path& dir, const SuiteResult& result,
-                   int position_digits = kDefaultSeriesDigits);
+void write_results(const std::filesystem::path& dir, const SuiteResult& result);
 
 // `--overhead FILE`: the harness's cost per scenario next to the engines' stepping (README
 // "Running at scale", "Harness overhead"), all CPU seconds. `process_cpu_seconds`: user +
