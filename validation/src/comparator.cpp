@@ -739,6 +739,21 @@ void ScenarioComparer::compare_run(RunRecord& run, bool enforce_gates) {
   run.containment.judged_escaped_bodies = run.containment.escaped_bodies;
   run.containment.judged_first_escape_time = run.containment.first_escape_time;
   for (std::string_view name : kMetricNames) run.metrics[std::string(name)] = std::nullopt;
+  if (run.status == RunStatus::Unsupported && enforce_gates) {
+    // Limits written for this engine by name ([gate.box2d]) that it cannot run checked
+    // nothing: the gate the user asked for did not happen, so `gate` fails it (a scenario
+    // run on an engine nobody named a limit for stays a skip).
+    if (auto it = scene.gate.per_engine.find(run.engine); it != scene.gate.per_engine.end() && !it->second.empty()) {
+      Check c;
+      c.what = "gate." + run.engine;
+      c.detail = "its limits checked nothing: " + run.engine + " " + run.reason;
+      c.limit = 0.0;
+      c.value = std::nullopt;
+      c.pass = false;
+      c.enforced = true;
+      run.checks.push_back(c);
+    }
+  }
   if (run.status == RunStatus::Unsupported || run.status == RunStatus::Error) return;
   run.metrics["wall_seconds"] = run.wall_seconds;
 

@@ -220,3 +220,44 @@ position = [0.0, 0.0]
 }
 
 }  // namespace
+
+// Limits written for an engine by name, on a scene that engine cannot model, checked
+// nothing: `[gate.box2d] energy_drift = 1e-12` over a scene with an explode emitter
+// (Box2D has no particles) passed the gate, exit 0, the run `<skipped/>` in JUnit. A user
+// who names an engine's limits asked for that engine to be checked: the run now fails
+// `gate` with the check `gate.box2d` naming why nothing ran; `run` still lists it as
+// unsupported, and an engine nobody named a limit for stays a skip.
+TEST_F(VacuousChecks, LimitsNamedForAnEngineThatCannotRunTheSceneFailTheGate) {
+  const std::string scene =
+      "name = \"named\"\nduration = 0.2\ndt = 0.01\n[[bodies]]\nname = \"a\"\nradius = 0.5\nposition = [0.0, 0.0]\n"
+      "[[emitters]]\nparent = \"a\"\nmode = \"explode\"\nat = 0.05\ncount = 4\nspeed = 1.0\nlifetime = 0.1\n"
+      "[[bodies]]\nname = \"b\"\nradius = 0.5\nposition = [5.0, 0.0]\nvelocity = [1.0, 0.0]\n"
+      "[expect]\nfinal = [{ body = \"b\", position = [5.2, 0.0] }]\n";
+  const fs::path named = write("named.toml", scene + "[gate.box2d]\nlinear_momentum_drift = 1e-12\n");
+  const fs::path junit = dir_ / "named.xml";
+  Result r = physval("gate --engines core,box2d " + named.string() + out() + " --junit " + junit.string());
+  EXPECT_EQ(r.status, 1) << r.output;
+  bool saw = false;
+  const nlohmann::json all = results();
+  for (const nlohmann::json& run : all["runs"]) {
+    if (run["engine"] != "box2d") continue;
+    saw = true;
+    EXPECT_EQ(run["status"], "unsupported") << run.dump();
+    bool failed = false;
+    for (const nlohmann::json& c : run["checks"]) {
+      if (c["what"].get<std::string>().rfind("gate.box2d", 0) == 0) failed = c["pass"] == false;
+    }
+    EXPECT_TRUE(failed) << run.dump();
+  }
+  EXPECT_TRUE(saw);
+  const std::string xml = read_text(junit);
+  EXPECT_NE(xml.find("failures=\"1\""), std::string::npos) << xml;
+  EXPECT_NE(xml.find("gate.box2d: its limits checked nothing: box2d cannot model: particles"), std::string::npos) << xml;
+  // `run` enforces nothing: the same file exits 0 with box2d unsupported.
+  r = physval("run --engines core,box2d " + named.string() + out());
+  EXPECT_EQ(r.status, 0) << r.output;
+  // Without a [gate.box2d] table the unsupported run is a skip and the gate passes.
+  const fs::path plain = write("plain.toml", scene);
+  r = physval("gate --engines core,box2d " + plain.string() + out());
+  EXPECT_EQ(r.status, 0) << r.output;
+}
