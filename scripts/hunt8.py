@@ -39,6 +39,11 @@ Families:
                falls (--quick: h 0.1 m, e 0.95 and 0.99, 10 and 30 falls): the bounces' closed form,
                at rest from t_fall (1 + e) / (1 - e); core exact (it ended the Zeno sequence early,
                `ok`, before zeno10); also sliding along the frictionless floor at 0.5 m/s.
+  zenoslide    a ball dropped on a face WITH friction tilted 0-35 degrees, launched along it,
+               e 0.3-0.95, three (mu_k, mu_s), steps of 0.5-100 falls (--quick: 30 degrees, e 0.9,
+               0.3 m/s, 10 and 30 falls): the bounces with impulsive Coulomb friction in closed
+               form, then the sliding contact; core exact (before zeno12 it settled the ball at
+               its first impact slower than its rest speed).
   ledge        a ball sliding off a box, a surface or two walls (0.3-8 m/s): flying off, or
                turning about the corner until the normal force is 0 (RK4), then flying.
 
@@ -559,6 +564,178 @@ restitution = {fmt(e)}
                     truth[name] = dict(final={"b": ((u * T, y + r), (u, vy))}, exact=True, scale=h)
 
 
+# ---------------------------------------------------------------- zenoslide
+def slide_phases(e, beta, gamma, u0):
+    """The slip's phases of a Zeno sequence with impulsive Coulomb friction (core's impact law,
+    collision_response.cpp): impact j (j = 0 the first) takes min(beta e^j, |u_j|) off the slip
+    u_j before it, never reversing it; flight j adds gamma e^j. Returns [(m, A, B)]: from impact
+    m on (to the next phase's m), the slip after impact j is A + B e^j."""
+    phases, m, u = [], 0, u0
+    while len(phases) < 6:
+        em = e ** m
+        if abs(u) <= beta * em:   # stopped at impact m
+            if abs(gamma) <= beta * e:
+                phases.append((m, 0.0, 0.0))   # stopped at every impact after
+                return phases
+            phases.append((m, 0.0, 0.0))   # one flight from rest, then sliding along gamma
+            u, m = gamma * em, m + 1
+            continue
+        sig = 1.0 if u > 0 else -1.0
+        B = (sig * beta * e - gamma) / (1 - e)
+        A = u - sig * beta * em - B * em
+        phases.append((m, A, B))
+        if not (sig * B > 0 and sig * A < 0):
+            return phases   # slides through every impact
+        j = max(m + 1, math.ceil(math.log(-A / B) / math.log(e)))
+        while j > m + 1 and not sig * (A + B * e ** (j - 1)) > 0:
+            j -= 1
+        while sig * (A + B * e ** j) > 0:
+            j += 1
+        u, m = A + (B + gamma) * e ** (j - 1), j
+    raise RuntimeError("more slip phases than expected")
+
+
+def slide_closed(h, e, mu_k, mu_s, tilt, u0, T, g=G0):
+    """A ball dropped from h (its lowest point) onto a face tilted by `tilt`, launched at u0 along
+    it, kinetic friction mu_k, static mu_s: (x along the face, y across it, vx, vy) at T. The
+    bounces from the first impact (at t_fall) summed in closed form (slide_phases, the
+    geometric sums of the flights), then the sliding contact from the Zeno limit t_fall +
+    2 e w / (a (1 - e)) (w = a t_fall): kinetic friction until the slip stops, then held iff
+    |a_t| <= max(mu_s, mu_k) a, else sliding from rest."""
+    a, at = g * math.cos(tilt), -g * math.sin(tilt)
+    tf = math.sqrt(2 * h / a)
+    if T <= tf:
+        return u0 * T + 0.5 * at * T * T, h - 0.5 * a * T * T, u0 + at * T, -a * T
+    w0 = a * tf
+    T0 = 2 * e * w0 / a
+    D = T0 / (1 - e)
+    beta, gamma = mu_k * (1 + e) * w0, at * T0
+    phases = slide_phases(e, beta, gamma, u0 + at * tf)
+    x0 = u0 * tf + 0.5 * at * tf * tf
+
+    def disp(m, A, B, n):   # flights m .. n-1 (n None: to the end)
+        em, en = e ** m, (0.0 if n is None else e ** n)
+        return A * T0 * (em - en) / (1 - e) + (B * T0 + 0.5 * at * T0 * T0) * (em * em - en * en) / (1 - e * e)
+
+    xs = [x0]   # displacement at each phase's first impact
+    for q in range(1, len(phases)):
+        m, A, B = phases[q - 1]
+        xs.append(xs[-1] + disp(m, A, B, phases[q][0]))
+    u = T - tf
+    if u < D:
+        left = 1 - u / D
+        k = max(0, int(math.floor(math.log(left) / math.log(e)))) if left < 1 else 0
+        while k > 0 and D * (1 - e ** k) > u:
+            k -= 1
+        while D * (1 - e ** (k + 1)) <= u:
+            k += 1
+        sig = u - D * (1 - e ** k)
+        q = max(i for i in range(len(phases)) if phases[i][0] <= k)
+        m, A, B = phases[q]
+        sk = A + B * e ** k
+        vk = e * w0 * e ** k
+        x = xs[q] + disp(m, A, B, k) + sk * sig + 0.5 * at * sig * sig
+        return x, max(0.0, sig * (vk - 0.5 * a * sig)), sk + at * sig, vk - a * sig
+    m, A, B = phases[-1]
+    x, s, u = xs[-1] + disp(m, A, B, None), A, u - D
+    if s != 0:
+        acc = at - math.copysign(mu_k * a, s)
+        if acc * s >= 0 or u < -s / acc:
+            return x + s * u + 0.5 * acc * u * u, 0.0, s + acc * u, 0.0
+        x, u = x + 0.5 * s * (-s / acc), u + s / acc
+    if abs(at) <= max(mu_s, mu_k) * a:
+        return x, 0.0, 0.0, 0.0
+    acc = at - math.copysign(mu_k * a, at)
+    return x + 0.5 * acc * u * u, 0.0, acc * u, 0.0
+
+
+def slide_direct(h, e, mu_k, mu_s, tilt, u0, T, g=G0):
+    """slide_closed's check: the bounces one at a time (until a flight adds nothing), then the
+    same contact law."""
+    a, at = g * math.cos(tilt), -g * math.sin(tilt)
+    tf = math.sqrt(2 * h / a)
+    if T <= tf:
+        return u0 * T + 0.5 * at * T * T, h - 0.5 * a * T * T, u0 + at * T, -a * T
+    t, w, s, x = tf, a * tf, u0 + at * tf, u0 * tf + 0.5 * at * tf * tf
+    for _ in range(100000):
+        cap = mu_k * (1 + e) * w
+        s = 0.0 if abs(s) <= cap else s - math.copysign(cap, s)
+        fl = 2 * e * w / a
+        if T < t + fl:
+            sig = T - t
+            return x + s * sig + 0.5 * at * sig * sig, max(0.0, sig * (e * w - 0.5 * a * sig)), s + at * sig, e * w - a * sig
+        if t + fl == t:
+            break
+        x += s * fl + 0.5 * at * fl * fl
+        s += at * fl
+        t += fl
+        w *= e
+    u = T - t
+    if s != 0:
+        acc = at - math.copysign(mu_k * a, s)
+        if acc * s >= 0 or u < -s / acc:
+            return x + s * u + 0.5 * acc * u * u, 0.0, s + acc * u, 0.0
+        x, u = x + 0.5 * s * (-s / acc), u + s / acc
+    if abs(at) <= max(mu_s, mu_k) * a:
+        return x, 0.0, 0.0, 0.0
+    acc = at - math.copysign(mu_k * a, at)
+    return x + 0.5 * acc * u * u, 0.0, acc * u, 0.0
+
+
+def gen_zenoslide(out, truth, quick):
+    """A ball dropped 0.1 m onto a face WITH friction, tilted 0-35 degrees, launched along it
+    (0, 0.3 m/s up, 0.5 m/s down, 1.5 m/s), e 0.3-0.95, (mu_k, mu_s) (0.2, 0.2), (0.3, 0.9),
+    (0.6, 0.7), steps of 0.5-100 of its falls, the duration 2 dt + 0.37 t_fall: slide_closed
+    (checked here against slide_direct). core exact (before zeno12 it ended the sequence at its
+    first impact slower than the rest speed |a| dt / 16, settling with one inelastic impact's
+    friction). Scenes within 2% of the static threshold (tan(tilt) against mu_s) are left out."""
+    r, h = 0.1, 0.1
+    for tilt_deg in ([0.0, 30.0] if quick else [0.0, 10.0, 20.0, 35.0]):
+        tilt = math.radians(tilt_deg)
+        dx, dy = math.cos(tilt), math.sin(tilt)
+        nx, ny = -dy, dx
+        for e in ([0.9] if quick else [0.3, 0.7, 0.9, 0.95]):
+            for mu_k, mu_s in ([(0.3, 0.9)] if quick else [(0.2, 0.2), (0.3, 0.9), (0.6, 0.7)]):
+                if tilt > 0 and abs(math.tan(tilt) - max(mu_s, mu_k)) < 0.02 * max(mu_s, mu_k):
+                    continue
+                for u0 in ([0.3] if quick else [0.0, 0.3, -0.5, 1.5]):
+                    for mult in ([10.0, 30.0] if quick else [0.5, 3.0, 10.0, 30.0, 100.0]):
+                        tf = math.sqrt(2 * h / (G0 * math.cos(tilt)))
+                        dt = mult * tf
+                        T = 2 * dt + 0.37 * tf
+                        x, y, vx, vy = slide_closed(h, e, mu_k, mu_s, tilt, u0, T)
+                        chk = slide_direct(h, e, mu_k, mu_s, tilt, u0, T)
+                        if max(abs(x - chk[0]), abs(y - chk[1])) > 1e-9 * (h + abs(x)):
+                            raise RuntimeError(f"zenoslide: closed form {x, y} and direct sum {chk[:2]} differ")
+                        name = (f"zenoslide_t{ident(tilt_deg)}_e{ident(e)}_mu{ident(mu_k)}s{ident(mu_s)}"
+                                f"_u{ident(u0)}_x{ident(mult)}")
+                        L = 10.0 + abs(u0) * T + G0 * T * T
+                        px, py = (x * dx + (y + r) * nx, x * dy + (y + r) * ny)
+                        write(out, name, f"""name = "{name}"
+duration = {fmt(T)}
+dt = {fmt(dt)}
+[world]
+gravity = [0.0, {fmt(-G0)}]
+[[bodies]]
+name = "b"
+radius = {fmt(r)}
+position = {vec(((h + r) * nx, (h + r) * ny))}
+velocity = {vec((u0 * dx, u0 * dy))}
+restitution = {fmt(e)}
+friction = {fmt(mu_k)}
+static_friction = {fmt(mu_s)}
+[[walls]]
+name = "face"
+from = {vec((-L * dx, -L * dy))}
+to = {vec((L * dx, L * dy))}
+restitution = {fmt(e)}
+friction = {fmt(mu_k)}
+static_friction = {fmt(mu_s)}
+""")
+                        truth[name] = dict(final={"b": ((px, py), (vx * dx + vy * nx, vx * dy + vy * ny))}, exact=True,
+                                           scale=max(h, abs(x)))
+
+
 # ---------------------------------------------------------------- sliver
 def gen_sliver(out, truth, quick):
     """A free ball and a ball bouncing on a floor over a whole number of steps and a sliver (the
@@ -777,7 +954,8 @@ def judge(name, t, runs, ref, out, find):
 
 
 FAMILIES = {"thrustfloor": gen_thrustfloor, "thrustslope": gen_thrustslope, "windfloor": gen_windfloor, "quadwind": gen_quadwind, "newtoncoll": gen_newtoncoll,
-            "scale": gen_scale, "hugedt": gen_hugedt, "sliver": gen_sliver, "boxcorner": gen_boxcorner, "ledge": gen_ledge, "zeno": gen_zeno}
+            "scale": gen_scale, "hugedt": gen_hugedt, "sliver": gen_sliver, "boxcorner": gen_boxcorner, "ledge": gen_ledge, "zeno": gen_zeno,
+            "zenoslide": gen_zenoslide}
 
 
 def run_hunt(tag, doc, families, judge_one, argv):

@@ -1088,16 +1088,108 @@ class EventLoop {
     std::uint32_t body, face, version;
     double t0, t_end, D, v0, a, e;
     Vec2 p, vt, at, n;
+    // With friction impulses (slide): the slip along `dir` (signed), after impact j (j = 0 the
+    // tail's first, at t0) of phase q (phase[q].m <= j < phase[q + 1].m) is A + B e^j; x: the
+    // displacement along dir at impact m from p. T0 = 2 v0 / a: flight j lasts T0 e^j.
+    bool slide = false;
+    int phases = 0;
+    double at_s = 0.0, T0 = 0.0;
+    Vec2 dir{};
+    struct SlipPhase {
+      double m, A, B, x;
+    } phase[6]{};
   };
+
+  // The displacement along the face over flights j in [m, n) of a phase (n may be infinite):
+  // sum of (A + B e^j) T0 e^j + at T0^2 e^(2j) / 2.
+  static double slide_disp(const Tail& z, const Tail::SlipPhase& f, double n) {
+    const double em = std::pow(z.e, f.m), en = std::isinf(n) ? 0.0 : std::pow(z.e, n);
+    return f.A * z.T0 * (em - en) / (1.0 - z.e) +
+           (f.B * z.T0 + 0.5 * z.at_s * z.T0 * z.T0) * (em * em - en * en) / (1.0 - z.e * z.e);
+  }
+  // Position along the face and slip at u (time since t0) of a sliding tail, in bounce k (k
+  // from tail_state), or the limit at the tail's end (k < 0).
+  static void slide_state(const Tail& z, double k, double sig, double& x, double& s) {
+    int q = z.phases - 1;
+    if (k >= 0.0) {
+      while (q > 0 && z.phase[q].m > k) --q;
+    }
+    const Tail::SlipPhase& f = z.phase[q];
+    if (k < 0.0) {
+      x = f.x + slide_disp(z, f, INFINITY);
+      s = f.A;
+      return;
+    }
+    const double sk = f.A + f.B * std::pow(z.e, k);
+    x = f.x + slide_disp(z, f, k) + sk * sig + 0.5 * z.at_s * sig * sig;
+    s = sk + z.at_s * sig;
+  }
+
+  // The slip's phases of a sliding tail (Tail::slide): impact j has normal change (1 + e) w e^j
+  // (w the first impact's closing speed) and takes min(mu (1 + e) w e^j, |u_j|) off the slip
+  // u_j before it (collision_response.cpp's Coulomb impulse: kinetic only, never reversing),
+  // flight j adds at T0 e^j. Phase from impact m on, sliding through in direction sig (sig u_j
+  // > beta e^j, beta = mu (1 + e) w): s_j = A + B e^j with B = (sig beta e - gamma) / (1 - e),
+  // gamma = at T0, and it slides through impact j > m iff sig (A + B e^j) > 0 (monotone in
+  // e^j: its end is a logarithm). A stop at impact m (|u_m| <= beta e^m) leaves the slip 0:
+  // stopped at every later impact if |gamma| <= beta e, else sliding along at through impact
+  // m + 1 for ever. Against at the slip may turn within a flight and slide through the next
+  // impact the other way. At most: against at, with at, a stop, with at again. False when it
+  // needs more phases (not expected).
+  static bool slide_phases(Tail& z, double u0, double beta) {
+    const double e = z.e, gamma = z.at_s * z.T0;
+    double m = 0.0, u = u0, x = 0.0;   // impact m, the slip before it, its displacement
+    z.phases = 0;
+    while (z.phases < 6) {
+      Tail::SlipPhase& f = z.phase[z.phases++];
+      f.m = m;
+      f.x = x;
+      const double em = std::pow(e, m);
+      if (std::fabs(u) <= beta * em) {   // stopped at impact m
+        if (std::fabs(gamma) <= beta * e) {
+          f.A = f.B = 0.0;   // stopped at every impact from m on
+          return true;
+        }
+        f.A = 0.0;   // one flight from rest, then sliding along at through impact m + 1
+        f.B = 0.0;
+        x += slide_disp(z, f, m + 1.0);
+        u = gamma * em;
+        m += 1.0;
+        continue;
+      }
+      const double sig = u > 0.0 ? 1.0 : -1.0;
+      const double s_m = u - sig * beta * em;
+      f.B = (sig * beta * e - gamma) / (1.0 - e);
+      f.A = s_m - f.B * em;
+      const auto through = [&](double j) { return sig * (f.A + f.B * std::pow(e, j)) > 0.0; };
+      // The first impact after m it does not slide through: sig A + sig B e^j <= 0.
+      if (!(sig * f.B > 0.0) || !(sig * f.A < 0.0)) return true;   // slides through every impact
+      double j = std::ceil(std::log(-f.A / f.B) / std::log(e));
+      if (!std::isfinite(j)) return true;
+      j = std::max(j, m + 1.0);
+      while (j > m + 1.0 && !through(j - 1.0)) j -= 1.0;
+      while (through(j)) j += 1.0;
+      x += slide_disp(z, f, j);
+      u = f.A + (f.B + gamma) * std::pow(e, j - 1.0);   // the slip before impact j
+      m = j;
+    }
+    return false;
+  }
 
   // The closed form of a Zeno tail at time s (z.t0 <= s): position and velocity. Bounce k
   // (k = 0, 1, ...) leaves the face at t0 + D (1 - e^k) with normal speed v0 e^k; from
   // t0 + D the body rests on the face (normal speed 0, the tangential motion goes on).
   static void tail_state(const Tail& z, double s, Vec2& pos, Vec2& vel) {
     const double u = std::max(0.0, s - z.t0);
-    const Vec2 along = z.p + u * z.vt + (0.5 * u * u) * z.at;
-    const Vec2 vt = z.vt + u * z.at;
+    Vec2 along = z.p + u * z.vt + (0.5 * u * u) * z.at;
+    Vec2 vt = z.vt + u * z.at;
     if (u >= z.D) {
+      if (z.slide) {
+        double x, sl;
+        slide_state(z, -1.0, 0.0, x, sl);
+        along = z.p + x * z.dir;
+        vt = sl * z.dir;
+      }
       pos = along;   // at rest on the face (moving along it)
       vel = vt;
       return;
@@ -1112,6 +1204,12 @@ class EventLoop {
     const double sig = u - start(k);
     const double vk = z.v0 * std::pow(z.e, k);
     const double h = std::max(0.0, sig * (vk - 0.5 * z.a * sig));
+    if (z.slide) {
+      double x, sl;
+      slide_state(z, static_cast<double>(k), sig, x, sl);
+      along = z.p + x * z.dir;
+      vt = sl * z.dir;
+    }
     pos = along + h * z.n;
     vel = vt + (vk - z.a * sig) * z.n;
   }
@@ -1159,8 +1257,18 @@ class EventLoop {
     if (!std::isfinite(D)) return false;
     const Vec2 vt = v - vn * n, at = w_.acc[i] - an * n;
     const double S = std::min(D, T_ - t);   // the tail's part in this step
+    Tail z{i, k, 0u, t, t + S, D, v0, a, e, p, vt, at, n};
+    // With friction and motion along the face: the slip's phases (slide_phases).
+    z.slide = !World::zeno_frictionless(m, v, w_.acc[i], n);
+    if (z.slide) {
+      z.dir = seg.dir;
+      z.at_s = dot(at, seg.dir);
+      z.T0 = 2.0 * v0 / a;
+      if (!slide_phases(z, dot(vt, seg.dir), m.friction * (1.0 + e) * -vn)) return false;
+    }
     // The box of the centre's path over the tail: along the face a parabola, across it at
-    // most v0^2 / (2 a) from the contact.
+    // most v0^2 / (2 a) from the contact. Sliding: within |u| S + |at| S^2 / 2 of p along the
+    // face (the impacts never raise the slip's size, the flights by at most |at| per second).
     double lo_x = p.x, hi_x = p.x, lo_y = p.y, hi_y = p.y;
     const auto take = [&](double s) {
       const Vec2 q = p + s * vt + (0.5 * s * s) * at;
@@ -1169,23 +1277,38 @@ class EventLoop {
       lo_y = std::min(lo_y, q.y);
       hi_y = std::max(hi_y, q.y);
     };
-    take(S);
-    if (at.x != 0.0 && -vt.x / at.x > 0.0 && -vt.x / at.x < S) take(-vt.x / at.x);
-    if (at.y != 0.0 && -vt.y / at.y > 0.0 && -vt.y / at.y < S) take(-vt.y / at.y);
+    const double reach_along = length(vt) * S + 0.5 * length(at) * S * S;
+    if (z.slide) {
+      const Vec2 ends[2] = {p - reach_along * seg.dir, p + reach_along * seg.dir};
+      for (const Vec2& q : ends) {
+        lo_x = std::min(lo_x, q.x);
+        hi_x = std::max(hi_x, q.x);
+        lo_y = std::min(lo_y, q.y);
+        hi_y = std::max(hi_y, q.y);
+      }
+    } else {
+      take(S);
+      if (at.x != 0.0 && -vt.x / at.x > 0.0 && -vt.x / at.x < S) take(-vt.x / at.x);
+      if (at.y != 0.0 && -vt.y / at.y > 0.0 && -vt.y / at.y < S) take(-vt.y / at.y);
+    }
     const Vec2 up = (v0 * v0 / (2.0 * a)) * n;
     lo_x += std::min(0.0, up.x);
     hi_x += std::max(0.0, up.x);
     lo_y += std::min(0.0, up.y);
     hi_y += std::max(0.0, up.y);
     // Its contact stays on the face's interior throughout (its projection is a parabola in
-    // time: checked at both ends and at its turn).
+    // time: checked at both ends and at its turn; sliding, its whole reach along the face).
     const double ud = dot(vt, seg.dir), ua = dot(at, seg.dir), u0 = dot(p - seg.from, seg.dir);
     const auto on_face = [&](double s) {
       const double u = u0 + s * ud + 0.5 * s * s * ua;
       return u >= 0.0 && u <= seg.length;
     };
-    if (!on_face(0.0) || !on_face(S)) return false;
-    if (ua != 0.0 && -ud / ua > 0.0 && -ud / ua < S && !on_face(-ud / ua)) return false;
+    if (z.slide) {
+      if (!(u0 - reach_along >= 0.0 && u0 + reach_along <= seg.length)) return false;
+    } else {
+      if (!on_face(0.0) || !on_face(S)) return false;
+      if (ua != 0.0 && -ud / ua > 0.0 && -ud / ua < S && !on_face(-ud / ua)) return false;
+    }
     const double r = w_.radius[i];
     const double tol = 1e-9 * (r + w_.length_scale + inf_norm(p));
     const Aabb tail_box = make_aabb(lo_x - r - tol, lo_y - r - tol, hi_x + r + tol, hi_y + r + tol);
@@ -1217,7 +1340,6 @@ class EventLoop {
         record_contact(w_, i, kNone, &seg, ctx_.t0 + tk, ctx_.dt);
       }
     }
-    Tail z{i, k, 0u, t, t + S, D, v0, a, e, p, vt, at, n};
     Vec2 pos, vel;
     tail_state(z, t + S, pos, vel);
     if (event) touch_contact(w_, i, partner, ctx_.t0 + tail_last_impact(z, t + S));

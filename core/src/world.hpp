@@ -386,11 +386,20 @@ struct World {
     return mode == CollisionMode::Exact && !varying_forces && !any_rules && !newtonian && emitters.empty() &&
            (integrator == Integrator::VelocityVerlet || integrator == Integrator::Rk4);
   }
-  // With friction too where the body has no motion along the face (its tangential velocity and
-  // acceleration at round-off of |v| and |a|: a ball dropped straight onto a level floor): no
-  // friction impulse acts at any impact of its tail, and at its end nothing pushes it along.
+  // The tail takes friction too (branch zeno12): the impacts' kinetic friction (mu_k, the
+  // pair's `friction`, finite and >= 0) with motion along the face, the slip summed in closed
+  // form phase by phase (zeno_tail's SlipPhase).
   static bool zeno_material(const PairMaterial& m, Vec2 v, Vec2 a, Vec2 n) {
+    (void)v, (void)a, (void)n;
     if (!(m.restitution > 0.0 && m.restitution < 1.0)) return false;
+    return std::isfinite(m.friction) && m.friction >= 0.0;
+  }
+  // The tail without friction impulses (the branch zeno10 form: along the face the body moves
+  // with constant acceleration throughout): no friction, or friction where the body has no
+  // motion along the face (its tangential velocity and acceleration at round-off of |v| and
+  // |a|: a ball dropped straight onto a level floor): no friction impulse acts at any impact of
+  // its tail, and at its end nothing pushes it along.
+  static bool zeno_frictionless(const PairMaterial& m, Vec2 v, Vec2 a, Vec2 n) {
     if (!(m.friction > 0.0) && !(m.static_friction > 0.0)) return true;
     const double eps = 64.0 * 2.220446049250313e-16;
     return length(v - dot(v, n) * n) <= eps * length(v) && length(a - dot(a, n) * n) <= eps * length(a);
