@@ -1000,7 +1000,14 @@ class EventLoop {
     }
     const PairMaterial m = w_.pair_material(w_.material[i], seg.material);
     const double vn = dot(w_.vel[i], n);
-    const double an = dot(w_.effective_acc(i), n);
+    // The acceleration pressing it now. A free body on sub-steps (drag, wind, thrust) has
+    // forces that depend on its velocity, and acc[i] is the step start's: after an impact
+    // inside the step it is stale. A body arriving at 12 m/s where its thrust table gives 0
+    // and stopped by an e = 0 wall is pushed back into it at once by the table's 4 m/s^2 at
+    // rest; read with the arrival's 0, that zero-speed impact was never "pressed", never
+    // settled, and repeated until the event cap (core diverged, no reference).
+    const Vec2 a_now = uses_substeps(w_, i) && !w_.supported(i) ? body_acceleration(w_, i, w_.vel[i]) : w_.effective_acc(i);
+    const double an = dot(a_now, n);
     const bool pressed = w_.any_forces && an < 0.0;
     const double vr = pressed ? w_.impact_rest_speed(an, ctx_.dt, m.restitution, vn) : 0.0;
     const bool slow = pressed && m.restitution * std::max(0.0, -vn) < vr;
