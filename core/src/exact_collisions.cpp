@@ -725,7 +725,7 @@ class EventLoop {
     bool settled = false;
     double closing = 0.0, rest_vr = 0.0;   // the pair's closing speed and rest speed, when pressed
     if (w_.any_forces) {
-      const double an = dot(w_.effective_acc(j) - w_.effective_acc(i), n);
+      const double an = dot(impact_acceleration(w_, j) - impact_acceleration(w_, i), n);   // (the face's case, below)
       const double vn = dot(w_.vel[j] - w_.vel[i], n);
       if (an < 0.0) {
         const double vr = w_.impact_rest_speed(an, ctx_.dt, e0, vn);
@@ -1006,8 +1006,7 @@ class EventLoop {
     // and stopped by an e = 0 wall is pushed back into it at once by the table's 4 m/s^2 at
     // rest; read with the arrival's 0, that zero-speed impact was never "pressed", never
     // settled, and repeated until the event cap (core diverged, no reference).
-    const Vec2 a_now = uses_substeps(w_, i) && !w_.supported(i) ? body_acceleration(w_, i, w_.vel[i]) : w_.effective_acc(i);
-    const double an = dot(a_now, n);
+    const double an = dot(impact_acceleration(w_, i), n);
     const bool pressed = w_.any_forces && an < 0.0;
     const double vr = pressed ? w_.impact_rest_speed(an, ctx_.dt, m.restitution, vn) : 0.0;
     const bool slow = pressed && m.restitution * std::max(0.0, -vn) < vr;
