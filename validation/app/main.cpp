@@ -247,10 +247,15 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
     // Every shard computes the same split from the whole suite; results.json records it
     // (with what the results depend on) so that `physval merge` can check the parts.
     std::vector<double> costs;
+    std::vector<nlohmann::json> engine_lists;   // the engines each scenario gets a run of (unsupported included)
     for (const Scene& s : *scenes) {
       const Scene e = effective_scene(s, options);
       std::size_t runnable = 0;
-      for (const EngineFactory* f : engines_for(e, o.engines)) runnable += unsupported_features(f->info, e).empty() ? 1 : 0;
+      engine_lists.push_back(nlohmann::json::array());
+      for (const EngineFactory* f : engines_for(e, o.engines)) {
+        runnable += unsupported_features(f->info, e).empty() ? 1 : 0;
+        engine_lists.back().push_back(f->info.name);
+      }
       costs.push_back(scenario_cost(e, runnable));
     }
     const std::vector<std::size_t> assigned = assign_shards(costs, shard->count);
@@ -259,7 +264,11 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
     double my_cost = 0.0, total_cost = 0.0;
     for (std::size_t i = 0; i < scenes->size(); ++i) {
       const Scene& s = (*scenes)[i];
-      list.push_back({{"name", s.name}, {"file", file_fingerprint(s.source_file)}, {"shard", assigned[i]}, {"cost", costs[i]}});
+      list.push_back({{"name", s.name},
+                      {"file", file_fingerprint(s.source_file)},
+                      {"shard", assigned[i]},
+                      {"cost", costs[i]},
+                      {"engines", engine_lists[i]}});
       total_cost += costs[i];
       if (assigned[i] == shard->index) {
         mine.push_back(s);

@@ -61,6 +61,10 @@ std::vector<std::string> failed_checks(const RunRecord& r) {
   std::vector<std::string> out;
   for (const Check& c : r.checks) {
     if (c.pass || !c.enforced) continue;
+    if (!c.value && !c.detail.empty()) {
+      out.push_back(c.what + ": " + c.detail);   // a check with nothing to measure says why it failed
+      continue;
+    }
     out.push_back(c.what + " = " + (c.value ? g(*c.value) : std::string("not measured")) + " > limit " + g(c.limit));
   }
   return out;

@@ -1,5 +1,6 @@
 #include "physval/validation/merge.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -142,7 +143,13 @@ int merge_suite(const MergeOptions& options, std::ostream& out, std::ostream& er
 
   // Each part holds exactly the scenarios the split gave it, whole.
   std::map<std::string, std::size_t> owner;
-  for (const json& s : shard["scenarios"]) owner[s["name"].get<std::string>()] = s["shard"].get<std::size_t>();
+  std::map<std::string, std::vector<std::string>> engines_of;   // the engines the split gave each scenario a run of
+  for (const json& s : shard["scenarios"]) {
+    owner[s["name"].get<std::string>()] = s["shard"].get<std::size_t>();
+    if (s.contains("engines") && s["engines"].is_array()) {
+      for (const json& e : s["engines"]) engines_of[s["name"].get<std::string>()].push_back(e.get<std::string>());
+    }
+  }
   std::map<std::string, json> runs, references, comparisons;   // scenario -> its entries, in run order
   for (const Part& p : parts) {
     const std::size_t index = p.doc["shard"]["index"].get<std::size_t>();
@@ -164,6 +171,18 @@ int merge_suite(const MergeOptions& options, std::ostream& out, std::ostream& er
     for (const auto& [scenario, i] : owner) {
       if (i == index && !references.count(scenario)) {
         throw Refused(p.dir + ": scenario " + scenario + " of shard " + std::to_string(index) + " is missing from it");
+      }
+      // Every engine the shard ran the scenario on has its run (a results.json that lost
+      // one, edited or cut, would merge into a suite one engine short, and pass).
+      if (i == index) {
+        for (const std::string& engine : engines_of[scenario]) {
+          const json& list = runs.count(scenario) ? runs[scenario] : json::array();
+          const bool has = std::any_of(list.begin(), list.end(), [&](const json& r) { return r.value("engine", "") == engine; });
+          if (!has) {
+            throw Refused(p.dir + ": scenario " + scenario + " has no run of " + engine +
+                          ", which the shard ran it on: the folder is not a whole shard output");
+          }
+        }
       }
       // Every scenario's series folder holds its scene.json: without it the folder was
       // copied in part (an artifact upload cut short), and the merge would lack its series.

@@ -183,6 +183,15 @@ TEST_F(ShardMerge, RefusesPartsOfDifferentJobs) {
   doc["physval_version"] = "0.0.1";
   write(root / "old" / "results.json", doc.dump());
   refused(s0 + s1 + " " + dir("old"), "physval version");
+  // A shard whose results.json lost a run (edited by hand, cut short) merged one engine
+  // short, exit 0 when what remained passed.
+  fs::copy(root / "s2", root / "cut", fs::copy_options::recursive);
+  doc = json::parse(read(root / "cut" / "results.json"));
+  ASSERT_FALSE(doc["runs"].empty());
+  const std::string lost = doc["runs"].back()["scenario"].get<std::string>();
+  doc["runs"].erase(doc["runs"].size() - 1);
+  write(root / "cut" / "results.json", doc.dump());
+  refused(s0 + s1 + " " + dir("cut"), "scenario " + lost + " has no run of core");
   write(suite / "basics" / "head_on_elastic.toml", read(suite / "basics" / "head_on_elastic.toml") + "\n# edited\n");
   ASSERT_NE(physval("gate" + common + " --engines core --shard 2/3 --out " + dir("edited")).status, 2);
   refused(s0 + s1 + " " + dir("edited"), "different scenario set");

@@ -220,3 +220,76 @@ position = [0.0, 0.0]
 }
 
 }  // namespace
+
+// Limits written for an engine by name, on a scene that engine cannot model, checked
+// nothing: `[gate.box2d] energy_drift = 1e-12` over a scene with an explode emitter
+// (Box2D has no particles) passed the gate, exit 0, the run `<skipped/>` in JUnit. A user
+// who names an engine's limits asked for that engine to be checked: the run now fails
+// `gate` with the check `gate.box2d` naming why nothing ran; `run` still lists it as
+// unsupported, and an engine nobody named a limit for stays a skip.
+TEST_F(VacuousChecks, LimitsNamedForAnEngineThatCannotRunTheSceneFailTheGate) {
+  const std::string scene =
+      "name = \"named\"\nduration = 0.2\ndt = 0.01\n[[bodies]]\nname = \"a\"\nradius = 0.5\nposition = [0.0, 0.0]\n"
+      "[[emitters]]\nparent = \"a\"\nmode = \"explode\"\nat = 0.05\ncount = 4\nspeed = 1.0\nlifetime = 0.1\n"
+      "[[bodies]]\nname = \"b\"\nradius = 0.5\nposition = [5.0, 0.0]\nvelocity = [1.0, 0.0]\n"
+      "[expect]\nfinal = [{ body = \"b\", position = [5.2, 0.0] }]\n";
+  const fs::path named = write("named.toml", scene + "[gate.box2d]\nlinear_momentum_drift = 1e-12\n");
+  const fs::path junit = dir_ / "named.xml";
+  Result r = physval("gate --engines core,box2d " + named.string() + out() + " --junit " + junit.string());
+  EXPECT_EQ(r.status, 1) << r.output;
+  bool saw = false;
+  const nlohmann::json all = results();
+  for (const nlohmann::json& run : all["runs"]) {
+    if (run["engine"] != "box2d") continue;
+    saw = true;
+    EXPECT_EQ(run["status"], "unsupported") << run.dump();
+    bool failed = false;
+    for (const nlohmann::json& c : run["checks"]) {
+      if (c["what"].get<std::string>().rfind("gate.box2d", 0) == 0) failed = c["pass"] == false;
+    }
+    EXPECT_TRUE(failed) << run.dump();
+  }
+  EXPECT_TRUE(saw);
+  const std::string xml = read_text(junit);
+  EXPECT_NE(xml.find("failures=\"1\""), std::string::npos) << xml;
+  EXPECT_NE(xml.find("gate.box2d: its limits checked nothing: box2d cannot model: particles"), std::string::npos) << xml;
+  // `run` enforces nothing: the same file exits 0 with box2d unsupported.
+  r = physval("run --engines core,box2d " + named.string() + out());
+  EXPECT_EQ(r.status, 0) << r.output;
+  // Without a [gate.box2d] table the unsupported run is a skip and the gate passes.
+  const fs::path plain = write("plain.toml", scene);
+  r = physval("gate --engines core,box2d " + plain.string() + out());
+  EXPECT_EQ(r.status, 0) << r.output;
+}
+
+// `[expect] apex` with a `time` is when the apex is first reached. A ball thrown up at
+// 5 m/s from an elastic floor (g 10) peaks at 1.75 m at t = 0.5 s and again every 1 s: the
+// probe kept the last of the equal maxima (core's round-off made t = 2.5 s the highest by
+// 1e-15 m) and failed core's exact run by 2 s, a false red. The time is now the first
+// sampled peak at or above the apex's height minus its tolerance; the height check still
+// takes the highest y of the whole run, so an engine that gains height later fails it.
+TEST_F(VacuousChecks, AnApexTimeIsTheFirstPeakThatReachesIt) {
+  const std::string scene =
+      "name = \"bounce_apex\"\nduration = 4.0\ndt = 0.01\n[world]\ngravity = [0.0, -10.0]\n"
+      "[[bodies]]\nname = \"ball\"\nradius = 0.5\nposition = [0.0, 0.5]\nvelocity = [0.0, 5.0]\nrestitution = 1.0\n"
+      "[[walls]]\nname = \"floor\"\nfrom = [-5.0, 0.0]\nto = [5.0, 0.0]\nrestitution = 1.0\n[expect]\n";
+  const fs::path first = write("first.toml", scene + "apex = [{ body = \"ball\", height = 1.75, time = 0.5, tolerance = 0.02 }]\n");
+  Result r = physval("gate --engines core " + first.string() + out());
+  EXPECT_EQ(r.status, 0) << r.output;
+  const nlohmann::json all = results();
+  ASSERT_EQ(all["runs"].size(), 1u);
+  for (const nlohmann::json& c : all["runs"][0]["checks"]) {
+    if (c["what"] == "expect.apex.ball.time") {
+      EXPECT_TRUE(c["pass"].get<bool>()) << c.dump();
+      EXPECT_LT(c["value"].get<double>(), 1e-9) << c.dump();
+    }
+  }
+  // A time the first peak does not hold still fails (the 1.5 s peak is not the first).
+  const fs::path later = write("later.toml", scene + "apex = [{ body = \"ball\", height = 1.75, time = 1.5, tolerance = 0.02 }]\n");
+  r = physval("gate --engines core " + later.string() + out());
+  EXPECT_EQ(r.status, 1) << r.output;
+  // A body that never gets within tolerance of the height fails both checks.
+  const fs::path high = write("high.toml", scene + "apex = [{ body = \"ball\", height = 1.9, time = 0.5, tolerance = 0.02 }]\n");
+  r = physval("gate --engines core " + high.string() + out());
+  EXPECT_EQ(r.status, 1) << r.output;
+}
