@@ -725,7 +725,7 @@ class EventLoop {
     bool settled = false;
     double closing = 0.0, rest_vr = 0.0;   // the pair's closing speed and rest speed, when pressed
     if (w_.any_forces) {
-      const double an = dot(w_.effective_acc(j) - w_.effective_acc(i), n);
+      const double an = dot(impact_acceleration(w_, j) - impact_acceleration(w_, i), n);   // (the face's case, below)
       const double vn = dot(w_.vel[j] - w_.vel[i], n);
       if (an < 0.0) {
         const double vr = w_.impact_rest_speed(an, ctx_.dt, e0, vn);
@@ -1000,7 +1000,13 @@ class EventLoop {
     }
     const PairMaterial m = w_.pair_material(w_.material[i], seg.material);
     const double vn = dot(w_.vel[i], n);
-    const double an = dot(w_.effective_acc(i), n);
+    // The acceleration pressing it now. A free body on sub-steps (drag, wind, thrust) has
+    // forces that depend on its velocity, and acc[i] is the step start's: after an impact
+    // inside the step it is stale. A body arriving at 12 m/s where its thrust table gives 0
+    // and stopped by an e = 0 wall is pushed back into it at once by the table's 4 m/s^2 at
+    // rest; read with the arrival's 0, that zero-speed impact was never "pressed", never
+    // settled, and repeated until the event cap (core diverged, no reference).
+    const double an = dot(impact_acceleration(w_, i), n);
     const bool pressed = w_.any_forces && an < 0.0;
     const double vr = pressed ? w_.impact_rest_speed(an, ctx_.dt, m.restitution, vn) : 0.0;
     const bool slow = pressed && m.restitution * std::max(0.0, -vn) < vr;

@@ -329,7 +329,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       // of the set that is so too takes the same rule, its own minimum separation, so
       // that which of two mirror-image pairs was found first (the numbering) does not matter.
       if (seed_min_sep > 0.0 && !(c.a & kSegmentContact) && w.any_forces) {
-        const double an = dot(w.effective_acc(c.b) - w.effective_acc(c.a), c.n);
+        const double an = dot(impact_acceleration(w, c.b) - impact_acceleration(w, c.a), c.n);
         if (an < 0.0) {
           const double vr = w.rest_speed(an, w.step_dt);
           if (e * std::max(0.0, -wn) < vr) c.target = std::max(c.target, 0.5 * vr);

@@ -165,6 +165,10 @@ Vec2 substep_acceleration(const World& w, std::uint32_t i, Vec2 v) {
   return support_acceleration(w, i, a, dot(w.vsub[i], perp(w.support_n[i])));
 }
 
+Vec2 impact_acceleration(const World& w, std::uint32_t i) {
+  return uses_substeps(w, i) && !w.supported(i) ? body_acceleration(w, i, w.vel[i]) : w.effective_acc(i);
+}
+
 bool needs_impact_refinement(const World& w, std::uint32_t i) {
   return w.integrator == Integrator::Rk4 && uses_substeps(w, i);
 }

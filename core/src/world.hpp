@@ -617,6 +617,10 @@ bool uses_substeps(const World& w, std::uint32_t i);
 // The acceleration of body i on sub-steps at velocity v: its forces', or on a face the
 // support's law with friction against the sliding direction of the sub-step's start.
 Vec2 substep_acceleration(const World& w, std::uint32_t i, Vec2 v);
+// The acceleration that presses body i's contacts at an impact: effective_acc, except that a
+// free body on sub-steps (forces depending on the velocity: drag, wind, thrust) has its forces
+// at its velocity now; acc[i] is its step start's, stale after an earlier impact in the step.
+Vec2 impact_acceleration(const World& w, std::uint32_t i);
 // Body i's state at time t of the step as its integrator gives it: one step of the
 // integrator from the start of its current sub-step to t. Off sub-steps: its path.
 struct PathState {

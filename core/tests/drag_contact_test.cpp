@@ -459,4 +459,50 @@ TEST(CoreDragContact, WindPushesARestingBallAlongTheFloor) {
   }
 }
 
+// A thrust table that gives nothing at the arrival speed and pushes at rest (a(v) = 4 (1 - v / 10),
+// 0 from 10 m/s up) carries a ball into a wall with e = 0: the impact stops it, and at rest the
+// table's 4 m/s^2 presses it into the wall, where it must stay (and, with a field along the
+// wall, slide down it freely). The pressing was read from the acceleration of the step's start
+// velocity (0 at the arrival speed), so the zero-speed impacts that followed were never
+// "pressed", never settled, and repeated until the event cap: core diverged and the scene had no
+// reference (hunt12, family thrustwall: every arrival at 10 m/s or more; the same against a
+// static ball, its face at x = 3 too). Fails without the fix.
+TEST(CoreDragContact, AThrustTablePressingABallStoppedOnAWallHoldsIt) {
+  for (const bool rock : {false, true}) {
+    for (const char* integrator : {"rk4", "velocity_verlet"}) {
+      for (const double v0 : {9.9, 10.0, 12.0, 15.0}) {
+        for (const double gy : {0.0, -9.8}) {
+          for (const double k : {0.0, 0.3}) {
+            if (rock && gy != 0.0) continue;   // on a round rock a field along x = 3 would roll it off
+            SCOPED_TRACE(std::string(rock ? "static ball " : "wall ") + integrator + " v0 " + std::to_string(v0) +
+                         " g " + std::to_string(gy) + " k " + std::to_string(k));
+            BodyDef b = circle("b", {0.0, 0.0}, {v0, 0.0}, 0.2, 1.0, 0.0);
+            b.thrust.speeds = {0.0, 10.0};
+            b.thrust.accel = {{4.0, 0.0}};
+            b.drag_linear = k;
+            BodyDef r = circle("rock", {4.0, 0.0}, {}, 1.0, 1.0, 0.0);
+            r.is_static = true;
+            Scene s = rock ? scene_of({b, r}, {}, {0.0, gy})
+                           : scene_of({b}, {wall("wall", {3.0, -100.0}, {3.0, 100.0}, 0.0)}, {0.0, gy});
+            Sim sim(s, options(integrator));
+            bool capped = false;
+            while (sim.engine.time() < 1.0 - 1e-12) {
+              sim.step(std::min(1.0 / 60.0, 1.0 - sim.engine.time()));
+              capped = capped || sim.engine.last_step_stats().event_cap_hit;
+            }
+            EXPECT_FALSE(capped);
+            const BodyState st = sim.state("b");
+            EXPECT_NEAR(st.position.x, 2.8, 1e-9);
+            EXPECT_NEAR(st.velocity.x, 0.0, 1e-9);
+            if (k == 0.0) {   // frictionless wall, no drag: it falls freely along it
+              EXPECT_NEAR(st.position.y, 0.5 * gy, 1e-9);
+              EXPECT_NEAR(st.velocity.y, gy, 1e-9);
+            }
+          }
+        }
+      }
+    }
+  }
+}
+
 }  // namespace physval::test
