@@ -622,6 +622,12 @@ TEST(Hunt, CoreJudgesAHoldMadeInTheLastStep) {
     Scene scene = *l.scene;
     scene.duration = duration;
     const RunRecord r = run_and_compare(scene, *core);
+    if (duration == 0.05) {   // since contact12: judged at step 2's start, moved in the contact-group mode
+      EXPECT_EQ(r.status, RunStatus::Ok) << duration << ": " << r.reason;
+      ASSERT_FALSE(r.limits_hit.empty());
+      EXPECT_NE(r.limits_hit.front().find("bodies moving in contact"), std::string::npos) << r.limits_hit.front();
+      continue;
+    }
     EXPECT_EQ(r.status, RunStatus::Diverged) << duration << ": " << r.reason;
     EXPECT_NE(r.reason.find("'top' at t = 0.0166667 s"), std::string::npos) << r.reason;
   }
