@@ -514,7 +514,9 @@ void load_state(const Group& g, const World& w, State& s) {
 }
 
 // The group's contacts with the faces near box (kept active/sticking where they were).
-void refresh_faces(World& w, Group& g, Aabb box) {
+// False where a face near the group has interpolated normals (a surface's smooth normals,
+// which the mode does not model).
+bool refresh_faces(World& w, Group& g, Aabb box) {
   std::vector<GC> keep;
   for (const GC& k : g.contacts) {
     if (k.a >= 0 || k.active) keep.push_back(k);
@@ -540,6 +542,11 @@ void refresh_faces(World& w, Group& g, Aabb box) {
     }
   }
   g.contacts = std::move(keep);
+  for (std::uint32_t k : w.found_static) {
+    const Segment& sg = w.statics.segments[k];
+    if (length_squared(sg.normal_from) > 0.0 || length_squared(sg.normal_to) > 0.0) return false;
+  }
+  return true;
 }
 
 struct Box {
@@ -722,6 +729,8 @@ void hide_contact_groups(World& w, const StepContext& ctx) {
     if (w.group_disturbed == kNone) {
       w.group_disturbed = g.members.front();
       w.group_disturbed_time = ctx.t0;
+      w.group_why = "a body that may meet it cannot join it (static, a particle or point, on a corner's cap, in another "
+                    "group, or over 16 members)";
     }
   }
   w.contact_groups = std::move(keep);
@@ -747,7 +756,11 @@ void advance_contact_groups(World& w, const StepContext& ctx) {
     for (int attempt = 0; attempt < 8; ++attempt) {
       s = s_start;
       const Box qbox = box_of(w, g.members, s, pad);
-      refresh_faces(w, g, make_aabb(qbox.x0, qbox.y0, qbox.x1, qbox.y1));
+      if (!refresh_faces(w, g, make_aabb(qbox.x0, qbox.y0, qbox.x1, qbox.y1)) && w.group_disturbed == kNone) {
+        w.group_disturbed = g.members.front();
+        w.group_disturbed_time = ctx.t0;
+        w.group_why = "a face near it has interpolated normals (a surface), which the mode does not model";
+      }
       if (g.fresh || attempt > 0) {
         select_active(c, s.x, s.v, g.contacts.size());
         g.fresh = false;
@@ -787,6 +800,7 @@ void advance_contact_groups(World& w, const StepContext& ctx) {
           } else if (!evs.empty() && w.group_disturbed == kNone) {
             w.group_disturbed = g.members.front();   // more events than a step may take
             w.group_disturbed_time = ctx.t0 + t;
+            w.group_why = "its events in one step passed the mode's limit (impacts that cycle)";
           }
           double vm = 0.0;
           for (const Vec2& q : e.v) vm = std::max(vm, length(q));
@@ -812,7 +826,7 @@ void advance_contact_groups(World& w, const StepContext& ctx) {
             if (first.kind == Ev::Impact && !impact(c, s, first.k) && w.group_disturbed == kNone) {
               w.group_disturbed = g.members[static_cast<std::size_t>(g.contacts[first.k].b)];
               w.group_disturbed_time = ctx.t0 + t;
-              w.group_disturbed_friction = true;
+              w.group_why = "an impact in it put an impulse on a sliding contact with friction, which the mode does not model";
             }
             select_active(c, s.x, s.v, exclude);
           }
@@ -834,6 +848,7 @@ void advance_contact_groups(World& w, const StepContext& ctx) {
       if (bj.overlaps(swept)) {
         w.group_disturbed = j;
         w.group_disturbed_time = ctx.t0;
+        w.group_why = "body '" + w.name(j) + "' came within reach of it (core finds no impacts of other bodies with a group)";
       }
     }
     // The mode failed in this step (a broken guarantee is reported): the group's step is undone

@@ -179,13 +179,10 @@ std::string CoreEngine::broken_guarantee() const {
   if (w.group_disturbed != core_detail::kNone) {
     std::ostringstream os;
     os << "bodies moving in contact (a group core moves on its contact forces, from t = " << w.group_first_time
-       << " s): at t = " << w.group_disturbed_time << " s "
-       << (w.group_disturbed_friction
-               ? "an impact in the group took an impulse at a sliding contact with friction, which the mode does not model"
-               : "body '" + w.name(w.group_disturbed) +
-                     "' came within reach of the group (or the group took more events than a step may): core does not "
-                     "find impacts of other bodies with a group")
-       << ", so bodies may have passed through each other (README, Several supports and inelastic collapse)";
+       << " s): at t = " << w.group_disturbed_time << " s core could not run the group with body '"
+       << w.name(w.group_disturbed) << "': " << w.group_why
+       << "; the group's step was undone and the engine took its bodies back, not exact from there (README, "
+          "Several supports and inelastic collapse)";
     return os.str();
   }
   if (w.cap_disturbed != core_detail::kNone) {

@@ -303,7 +303,7 @@ struct World {
   // with friction on a sliding contact, or more events than a step may take. A broken guarantee.
   std::uint32_t group_disturbed = kNone;
   double group_disturbed_time = -1.0;
-  bool group_disturbed_friction = false;
+  std::string group_why;   // what it did not model
 
   // ---- convex corners (convex_cap.cpp): bodies riding a segment end's cap, the circle of
   // radius r about the corner their centre moves on (a curved support), by body index.
