@@ -2,11 +2,15 @@
 // with `range(0)` contact events per run, bodies and samples of a 1k-body scene).
 #include <benchmark/benchmark.h>
 
+#include <unistd.h>
+
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <random>
 
 #include "physval/validation/comparator.hpp"
+#include "physval/validation/results_json.hpp"
 #include "physval/validation/runner.hpp"
 #include "../src/containment.hpp"
 #include "../src/number_text.hpp"
@@ -265,6 +269,53 @@ void BM_SeriesNumberText(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(values.size()));
 }
 BENCHMARK(BM_SeriesNumberText)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+// write_results on circle_gas's shape (one scenario, five engine runs and a reference of 200
+// bodies x 301 samples, positions in +-1.1 m), into a fresh folder under $TMPDIR: the series'
+// text, the files' creation and the kernel's copy into the page cache (CPU time counts the
+// system time). perf of it (README "Harness overhead", eleventh pass): the number text about
+// two thirds, the kernel's copy 2-3%.
+void BM_WriteSeriesGas(benchmark::State& state) {
+  SuiteResult suite;
+  ScenarioResult sr;
+  sr.scene.name = "gas";
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> position(-1.1, 1.1), energy(30.0, 50.0);
+  RunRecord r;
+  r.scenario = "gas";
+  r.bodies.resize(200);
+  for (std::size_t i = 0; i < r.bodies.size(); ++i) r.bodies[i].name = "c" + std::to_string(i);
+  for (int k = 0; k <= 300; ++k) {
+    r.series.time.push_back(k / 60.0);
+    Totals t;
+    t.kinetic = energy(rng);
+    t.momentum = {position(rng), position(rng)};
+    t.angular_momentum = position(rng);
+    r.series.totals.push_back(t);
+    SampleRow row(r.bodies.size());
+    for (SampleState& s : row) s = SampleState({position(rng), position(rng)}, true);
+    r.series.states.push_back(std::move(row));
+  }
+  for (const char* e : {"core", "box2d", "bullet", "chipmunk", "ode"}) {
+    r.engine = e;
+    sr.runs.push_back(r);
+  }
+  r.engine = "reference";
+  sr.reference.available = true;
+  sr.reference.run = r;
+  suite.scenarios.push_back(std::move(sr));
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("physval-bench-series-" + std::to_string(::getpid()));
+  int n = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    std::filesystem::remove_all(dir);
+    state.ResumeTiming();
+    write_results(dir / std::to_string(n++ % 2), suite);
+  }
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_WriteSeriesGas)->Unit(benchmark::kMillisecond);
 
 // The stepping loop's own cost a step (runner.cpp: the clock, the clock check, reading the
 // motion, containment, the sample countdown): run_engine on an engine whose step() does

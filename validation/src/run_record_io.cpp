@@ -93,6 +93,11 @@ void write_record(Sink& sink, const RunRecord& r) {
     w.str(p.body);
     w.f64(p.max_y);
     w.f64(p.max_y_time);
+    w.u64(p.apex_first.size());
+    for (const auto& [threshold, time] : p.apex_first) {
+      w.f64(threshold);
+      w.f64(time);
+    }
     w.f64(p.revolutions);
     w.f64(p.last_full_rev_time);
     w.i64(p.full_revolutions);
@@ -380,6 +385,10 @@ RunRecord read_record(Source& source) {
     p.body = rd.str();
     p.max_y = rd.f64();
     p.max_y_time = rd.f64();
+    for (std::uint64_t m = rd.count(), j = 0; j < m; ++j) {
+      const double threshold = rd.f64();
+      p.apex_first.emplace_back(threshold, rd.f64());
+    }
     p.revolutions = rd.f64();
     p.last_full_rev_time = rd.f64();
     p.full_revolutions = static_cast<int>(rd.i64());

@@ -171,7 +171,21 @@ struct ProbeTracker {
   bool tracks_period;
   double last_angle = 0.0;
   double accumulated = 0.0;
+  // The last sample of y and whether y rose (or held) into it, for the apexes' local maxima.
+  bool have_prev = false;
+  bool prev_rising = true;
+  double prev_y = 0.0;
+  double prev_t = 0.0;
 };
+
+// The previous sample is a local maximum of y (the start counts: nothing came before it);
+// the first one at or above an apex's threshold is that apex's time.
+void note_apex_peak(ProbeTracker& tr, Probe& p, bool peak) {
+  if (!peak) return;
+  for (auto& [threshold, time] : p.apex_first) {
+    if (std::isnan(time) && tr.prev_y >= threshold) time = tr.prev_t;
+  }
+}
 
 }  // namespace
 
@@ -211,7 +225,13 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
       r.probes.push_back(Probe{body});
       trackers.push_back({static_cast<std::size_t>(i), around, period});
     };
-    for (const ExpectedApex& a : scene.expect.apex) add_probe(a.body, false, {});
+    for (const ExpectedApex& a : scene.expect.apex) {
+      add_probe(a.body, false, {});
+      if (!a.time) continue;
+      for (Probe& p : r.probes) {
+        if (p.body == a.body) p.apex_first.emplace_back(a.height - a.tolerance.value_or(1e-3), std::numeric_limits<double>::quiet_NaN());
+      }
+    }
     for (const ExpectedPeriod& p : scene.expect.period) add_probe(p.body, true, p.around);
 
     const long every = sample_every(scene, options.max_sample_states);
@@ -261,6 +281,17 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
         if (s.position.y > p.max_y) {
           p.max_y = s.position.y;
           p.max_y_time = t;
+        }
+        if (!p.apex_first.empty()) {
+          ProbeTracker& tr = trackers[k];
+          const double y = s.position.y;
+          if (tr.have_prev) {
+            note_apex_peak(tr, p, tr.prev_rising && tr.prev_y >= y);
+            tr.prev_rising = y >= tr.prev_y;
+          }
+          tr.have_prev = true;
+          tr.prev_y = y;
+          tr.prev_t = t;
         }
         if (trackers[k].tracks_period) {
           const Vec2 d = s.position - trackers[k].around;
@@ -360,6 +391,10 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
       wall = loop_ticks > 0 ? loop_wall * std::min(1.0, timing.step_ticks(loop_ticks) / static_cast<double>(loop_ticks)) : 0.0;
       r.wall_seconds = wall;
       r.step_cpu_seconds = loop_wall > 0.0 ? std::min(loop_cpu, loop_cpu * wall / loop_wall) : 0.0;
+    }
+    // The last sample is a peak if y rose (or held) into it: a body still rising at the end.
+    for (std::size_t k = 0; k < trackers.size(); ++k) {
+      if (trackers[k].have_prev) note_apex_peak(trackers[k], r.probes[k], trackers[k].prev_rising);
     }
     r.limits_hit = engine->limits_hit();
     engine->read_states(states);

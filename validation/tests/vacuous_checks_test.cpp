@@ -261,3 +261,35 @@ TEST_F(VacuousChecks, LimitsNamedForAnEngineThatCannotRunTheSceneFailTheGate) {
   r = physval("gate --engines core,box2d " + plain.string() + out());
   EXPECT_EQ(r.status, 0) << r.output;
 }
+
+// `[expect] apex` with a `time` is when the apex is first reached. A ball thrown up at
+// 5 m/s from an elastic floor (g 10) peaks at 1.75 m at t = 0.5 s and again every 1 s: the
+// probe kept the last of the equal maxima (core's round-off made t = 2.5 s the highest by
+// 1e-15 m) and failed core's exact run by 2 s, a false red. The time is now the first
+// sampled peak at or above the apex's height minus its tolerance; the height check still
+// takes the highest y of the whole run, so an engine that gains height later fails it.
+TEST_F(VacuousChecks, AnApexTimeIsTheFirstPeakThatReachesIt) {
+  const std::string scene =
+      "name = \"bounce_apex\"\nduration = 4.0\ndt = 0.01\n[world]\ngravity = [0.0, -10.0]\n"
+      "[[bodies]]\nname = \"ball\"\nradius = 0.5\nposition = [0.0, 0.5]\nvelocity = [0.0, 5.0]\nrestitution = 1.0\n"
+      "[[walls]]\nname = \"floor\"\nfrom = [-5.0, 0.0]\nto = [5.0, 0.0]\nrestitution = 1.0\n[expect]\n";
+  const fs::path first = write("first.toml", scene + "apex = [{ body = \"ball\", height = 1.75, time = 0.5, tolerance = 0.02 }]\n");
+  Result r = physval("gate --engines core " + first.string() + out());
+  EXPECT_EQ(r.status, 0) << r.output;
+  const nlohmann::json all = results();
+  ASSERT_EQ(all["runs"].size(), 1u);
+  for (const nlohmann::json& c : all["runs"][0]["checks"]) {
+    if (c["what"] == "expect.apex.ball.time") {
+      EXPECT_TRUE(c["pass"].get<bool>()) << c.dump();
+      EXPECT_LT(c["value"].get<double>(), 1e-9) << c.dump();
+    }
+  }
+  // A time the first peak does not hold still fails (the 1.5 s peak is not the first).
+  const fs::path later = write("later.toml", scene + "apex = [{ body = \"ball\", height = 1.75, time = 1.5, tolerance = 0.02 }]\n");
+  r = physval("gate --engines core " + later.string() + out());
+  EXPECT_EQ(r.status, 1) << r.output;
+  // A body that never gets within tolerance of the height fails both checks.
+  const fs::path high = write("high.toml", scene + "apex = [{ body = \"ball\", height = 1.9, time = 0.5, tolerance = 0.02 }]\n");
+  r = physval("gate --engines core " + high.string() + out());
+  EXPECT_EQ(r.status, 1) << r.output;
+}

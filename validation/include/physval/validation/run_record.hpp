@@ -73,6 +73,10 @@ struct Probe {
   std::string body;
   double max_y = -1e300;
   double max_y_time = 0.0;
+  // For each `[expect] apex` of this body with a `time`: its threshold (height - tolerance)
+  // and the time of the first sampled local maximum of y at or above it (NaN: none). A
+  // periodic motion reaches equal maxima again and again; its apex time is the first.
+  std::vector<std::pair<double, double>> apex_first;
   double revolutions = 0.0;       // accumulated angle / 2 pi around `around`
   double last_full_rev_time = 0.0;   // time of the last completed revolution
   int full_revolutions = 0;
