@@ -72,6 +72,10 @@ void CoreEngine::step(double dt) {
                                           : core_detail::default_event_cap(w.size());
   const bool exact = w.mode == CollisionMode::Exact;
 
+  // 0. bodies moving in contact: hidden from the step, advanced after it (contact_group.cpp)
+  w.group_dt = dt;
+  const bool groups = !w.contact_groups.empty();
+  if (groups) core_detail::hide_contact_groups(w, ctx);
   // 1. forces: accelerations at the start of the step
   if (w.any_forces) {
     core_detail::forget_old_contacts(w, ctx.t0, dt);
@@ -89,6 +93,7 @@ void CoreEngine::step(double dt) {
   }
   // 5. integrator: everyone to the end of the step, end-of-step corrections
   core_detail::end_paths(w, ctx);
+  if (groups || !w.contact_groups.empty()) core_detail::advance_contact_groups(w, ctx);
   // 6. particles: explosions and trails spawn, lives end
   if (!w.emitters.empty()) core_detail::finish_particles(w, ctx);
 
@@ -171,6 +176,15 @@ std::string CoreEngine::broken_guarantee() const {
           "for wrong greens)";
     return os.str();
   }
+  if (w.group_disturbed != core_detail::kNone) {
+    std::ostringstream os;
+    os << "bodies moving in contact (a group core moves on its contact forces, from t = " << w.group_first_time
+       << " s): at t = " << w.group_disturbed_time << " s core could not run the group with body '"
+       << w.name(w.group_disturbed) << "': " << w.group_why
+       << "; the group's step was undone and the engine took its bodies back, not exact from there (README, "
+          "Several supports and inelastic collapse)";
+    return os.str();
+  }
   if (w.cap_disturbed != core_detail::kNone) {
     std::ostringstream os;
     os << "a body came within reach of body '" << w.name(w.cap_disturbed) << "' riding a convex corner's cap at t = "
@@ -194,6 +208,14 @@ std::vector<std::string> CoreEngine::limits_hit() const {
     std::ostringstream os;
     os << "event cap reached in " << w.cap_hits << " step(s), first at t = " << w.first_cap_time
        << " s; the rest of each such step was finished by the lecture pass (max_events_per_step)";
+    out.push_back(os.str());
+  }
+  if (w.group_steps > 0) {
+    std::ostringstream os;
+    os << "bodies moving in contact from t = " << w.group_first_time << " s (" << w.group_steps << " group step(s), "
+       << w.group_events
+       << " event(s)): a resting group core could not hold moved on its contact forces, integrated by RK4 on "
+          "sub-steps of dt/8 and projected onto its contacts (order 4, not exact)";
     out.push_back(os.str());
   }
   if (w.cap_unmodelled > 0) {

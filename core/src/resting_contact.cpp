@@ -1551,7 +1551,7 @@ Verdict component_holds(World& w, const BodiesByX& bx, std::span<const std::uint
 // (component_holds). A component that cannot hold is a broken guarantee, as an unbraced
 // group is in try_hold. Components found able to hold are remembered (members, positions
 // and force accelerations, bit for bit): a settled pile is solved once.
-void judge_braced_holds(World& w) {
+void judge_braced_holds(World& w, bool engage) {
   if (w.braced_holds.empty()) return;
   thread_local BodiesByX bx;
   thread_local std::vector<std::uint32_t> members, judged;
@@ -1583,6 +1583,9 @@ void judge_braced_holds(World& w) {
       w.justified_components.push_back(key);
       continue;
     }
+    // A component that must move: moved by the contact-group mode where it applies (at a
+    // step's start, its members all at rest), else a broken guarantee.
+    if (engage && v == Verdict::kCannotHold && engage_contact_group(w, members)) continue;
     w.unjustified_hold = i;
     w.unjustified_hold_time = w.time;
     w.unjustified_component = members.size();
@@ -2182,7 +2185,7 @@ void apply_supports(World& w, const StepContext& ctx) {
     }
     if (hold_pass(w, ctx)) changed = true;
   }
-  judge_braced_holds(w);
+  judge_braced_holds(w, true);
   if (!w.varying_forces) push_trains(w);
 }
 

@@ -277,6 +277,34 @@ struct World {
   std::vector<JudgedComponent> justified_components;
   std::int64_t max_events_seen = 0;
 
+  // ---- bodies moving in contact (contact_group.cpp): groups of free bodies that a hold could
+  // not justify, moved on the acceleration-level contact problem between events (RK4 on
+  // sub-steps, projected onto the active constraints). Their members are hidden from the rest
+  // of the step (not alive) and advanced after it.
+  struct GroupContact {
+    std::int32_t a = -1, b = 0;   // member indices; a = -1: segment seg
+    std::uint32_t seg = 0;
+    double mu_k = 0.0, mu_s = 0.0, e = 0.0;
+    bool active = false, sticking = false;
+    double slip = 0.0;   // a sliding contact's direction of slip along perp(n), +-1; 0: none
+  };
+  struct ContactGroup {
+    std::vector<std::uint32_t> members;
+    std::vector<Vec2> acc;   // the members' force accelerations (constant: no varying forces)
+    std::vector<GroupContact> contacts;
+    bool fresh = true;       // its active set is chosen at its next step's start
+  };
+  std::vector<ContactGroup> contact_groups;
+  double group_dt = 0.0;
+  std::vector<Vec2> group_p0, group_v0;   // every body's state at the step's start (scratch)
+  std::int64_t group_steps = 0, group_events = 0;
+  double group_first_time = -1.0;
+  // Something the group mode does not model: another body within reach of a group, an impact
+  // with friction on a sliding contact, or more events than a step may take. A broken guarantee.
+  std::uint32_t group_disturbed = kNone;
+  double group_disturbed_time = -1.0;
+  std::string group_why;   // what it did not model
+
   // ---- convex corners (convex_cap.cpp): bodies riding a segment end's cap, the circle of
   // radius r about the corner their centre moves on (a curved support), by body index.
   struct CapRide {
@@ -441,7 +469,7 @@ void compute_accelerations(World& w, std::span<const Vec2> pos, std::span<const 
 // gravity, which needs every body) at velocity vel (accelerations.cpp).
 Vec2 body_acceleration(const World& w, std::uint32_t i, Vec2 vel);
 void apply_supports(World& w, const StepContext& ctx);          // resting_contact.cpp
-void judge_braced_holds(World& w);                              // resting_contact.cpp
+void judge_braced_holds(World& w, bool engage = false);                              // resting_contact.cpp
 void begin_paths(World& w, const StepContext& ctx);             // integrators.cpp
 void collide_exact(World& w, StepContext& ctx);                 // exact_collisions.cpp
 void collide_lecture(World& w, StepContext& ctx, double t_from);   // lecture_collisions.cpp
@@ -691,6 +719,13 @@ void touch_contact(World& w, std::uint32_t i, std::uint32_t partner, double t_ab
 void forget_old_contacts(World& w, double t0, double dt);
 
 void kill_body(World& w, std::uint32_t i);
+
+// Bodies moving in contact (contact_group.cpp). A resting component that cannot hold
+// (members at rest) becomes a contact group, moved by advance_contact_groups at each step's
+// end; false (nothing changed) where the mode does not apply.
+bool engage_contact_group(World& w, std::span<const std::uint32_t> members);
+void hide_contact_groups(World& w, const StepContext& ctx);
+void advance_contact_groups(World& w, const StepContext& ctx);
 
 // Pass-through pairs (collision matrix "event" and overlap tracking).
 std::uint64_t pair_key(std::uint32_t i, std::uint32_t j);

@@ -28,6 +28,20 @@ std::string run_for_report(Sim& sim) {
   return {};
 }
 
+// Whether core moved a component it could not hold in its contact-group mode (contact12:
+// such components used to be reported as a broken guarantee).
+bool grouped(const Sim& sim) {
+  for (const std::string& l : sim.engine.limits_hit()) {
+    if (l.find("bodies moving in contact") != std::string::npos) return true;
+  }
+  return false;
+}
+
+// A group-mode report (what it does not model), or none.
+bool group_report_or_none(const std::string& report) {
+  return report.empty() || report.find("bodies moving in contact") != std::string::npos;
+}
+
 // Ball-floor friction mu on the named balls (the pair rule sqrt(f1 f2) would give 0 under
 // frictionless balls); the balls themselves are frictionless.
 void floor_friction(Scene& sc, const std::vector<std::string>& names, double mu) {
@@ -59,11 +73,23 @@ TEST(CoreBraced, AFrictionlessPyramidIsHeldIffItsBracesReachAWall) {
         Sim sim(scene_of(b, walls, {0.0, -g}));
         const bool holds = gap == 0.0;
         const std::string report = run_for_report(sim);
-        EXPECT_EQ(report.empty(), holds) << report;
+        // Since contact12 a component that cannot hold moves in the contact-group mode: with no
+        // right wall the pyramid spreads for ever. Open: where the brace meets the right wall
+        // (gap 1e-3, 1e-6) the group's impacts there cycle beyond the mode's 256 events in a
+        // step; the mode then undoes that step and reports the broken guarantee (diverged),
+        // never `ok`.
+        EXPECT_TRUE(group_report_or_none(report)) << report;
         if (!holds) {
-          EXPECT_NE(report.find("'top'"), std::string::npos) << report;
-          EXPECT_NE(report.find("every body at rest they touch (4 bodies"), std::string::npos) << report;
+          if (gap < 0.0) {
+            EXPECT_TRUE(grouped(sim)) << report;
+            EXPECT_TRUE(report.empty()) << report;
+            EXPECT_LT(sim.state("top").position.y, r + s3 * r - 0.1);
+          } else {
+            EXPECT_FALSE(report.empty());
+          }
         } else {
+          EXPECT_FALSE(grouped(sim));
+          EXPECT_TRUE(report.empty()) << report;
           // Held exactly where it was, with no events once at rest.
           EXPECT_NEAR(sim.state("top").position.y, r + s3 * r, 1e-9);
           EXPECT_EQ(sim.state("brace").position, (Vec2{3.0 * r, r}));
@@ -101,14 +127,19 @@ TEST(CoreBraced, AHoldMadeInTheLastStepIsJudged) {
       for (int k = 0; k < steps && report.empty(); ++k) {
         sim.step(dt);
         report = sim.engine.broken_guarantee();
-        // the top is held on the bottom balls from the first step on
-        EXPECT_EQ(sim.state("top").velocity, (Vec2{0.0, 0.0}));
+        // the top is held on the bottom balls in the first step (and for ever with the wall)
+        if (k == 0 || right_wall) EXPECT_EQ(sim.state("top").velocity, (Vec2{0.0, 0.0}));
       }
       if (right_wall) {
         EXPECT_TRUE(report.empty()) << report;
-      } else {
+        EXPECT_FALSE(grouped(sim));
+      } else if (steps == 1) {   // judged at the run's end: nothing can move it any more
         EXPECT_NE(report.find("'top' at t = 0.0166667 s"), std::string::npos) << report;
         EXPECT_NE(report.find("cannot hold it"), std::string::npos) << report;
+      } else {   // since contact12: judged at the second step's start, moved in the contact-group mode
+        EXPECT_TRUE(group_report_or_none(report)) << report;
+        EXPECT_TRUE(grouped(sim));
+        EXPECT_LT(sim.state("top").velocity.y, 0.0);
       }
     }
   }
@@ -152,10 +183,11 @@ TEST(CoreBraced, TwoLayersBetweenWallsHoldIffTheFloorFrictionSays) {
         Sim sim(sc);
         const bool holds = walls_touch || mu >= threshold;
         const std::string report = run_for_report(sim);
-        EXPECT_EQ(report.empty(), holds) << report;
-        if (!holds) {
-          EXPECT_NE(report.find("cannot hold it"), std::string::npos) << report;
-        } else {
+        // Since contact12: moved in the contact-group mode iff it cannot hold.
+        EXPECT_EQ(grouped(sim), !holds) << report;
+        EXPECT_TRUE(group_report_or_none(report)) << report;
+        if (holds) {
+          EXPECT_TRUE(report.empty()) << report;
           for (int k = 0; k + 1 < n_bottom; ++k) {
             const BodyState t = sim.state("t" + std::to_string(k));
             EXPECT_NEAR(t.position.x, x0 + d * (k + 0.5), 1e-9) << k;
@@ -192,11 +224,10 @@ TEST(CoreBraced, ABallMovingAlongAHeldColumnBreaksItsHoldIffItPushesItOver) {
       sim.step(1.0 / 60.0);
       const std::string report = sim.engine.broken_guarantee();
       const bool holds = wall_left || phi_deg == 0.0;
-      EXPECT_EQ(report.empty(), holds) << report;
-      if (!holds) {
-        EXPECT_NE(report.find("'top'"), std::string::npos) << report;
-        EXPECT_NE(report.find("cannot hold it"), std::string::npos) << report;
-      } else {
+      // Since contact12 the column that cannot hold moves in the contact-group mode.
+      EXPECT_EQ(grouped(sim), !holds) << report;
+      EXPECT_TRUE(group_report_or_none(report)) << report;
+      if (holds) {
         EXPECT_EQ(sim.state("top").position, top);
         EXPECT_EQ(sim.state("top").velocity, Vec2{});
         EXPECT_LT(sim.state("mover").velocity.y, 0.0);   // it moves on

@@ -278,7 +278,10 @@ TEST_P(CorePileSettles, SettlesWithoutOverlapCapOrEnergyGain) {
     // show"); everything else below is asserted all the same (core's path is not the
     // physics then, but it must still never overlap, gain energy or hit the event cap).
     if (const std::string b = sim.engine.broken_guarantee(); !b.empty() && beyond.empty()) {
-      ASSERT_NE(b.find("cannot hold it"), std::string::npos) << "step " << k << ": " << b;
+      // (or, since contact12, the contact-group mode that moves such a component reporting
+      // what it does not model there)
+      ASSERT_TRUE(b.find("cannot hold it") != std::string::npos || b.find("bodies moving in contact") != std::string::npos)
+          << "step " << k << ": " << b;
       beyond = b;
     }
     sim.engine.read_states(sim.states);
