@@ -593,15 +593,124 @@ void set_alive(World& w, const Group& g, bool alive) {
 
 }  // namespace
 
-static bool plan_absorb(const World& w, const std::vector<std::uint32_t>& members, double dt,
-                        std::vector<std::uint32_t>& add);
 static void apply_absorb(World& w, Group& g, const std::vector<std::uint32_t>& add);
 
-bool engage_contact_group(World& w, std::span<const std::uint32_t> members) {
-  if (w.mode != CollisionMode::Exact || w.varying_forces || w.any_rules || !w.emitters.empty() || w.acc.empty()) {
-    return false;
+bool contact_groups_allowed(const World& w) {
+  return w.mode == CollisionMode::Exact && !w.varying_forces && !w.any_rules && w.emitters.empty() && !w.acc.empty() &&
+         !w.newtonian;
+}
+
+// How far body i can go in a step of dt (its speed, its force and a contact's push).
+static double reach_of(const World& w, std::uint32_t i, double dt, double ascale) {
+  const double a = w.acc.empty() ? 0.0 : length(w.acc[i]);
+  return length(w.vel[i]) * dt + (a + 4.0 * ascale) * dt * dt;
+}
+
+static void to_granular(Group& g) {
+  g.granular = true;
+  g.contacts.clear();
+  g.sleeping = false;
+  g.fresh = true;
+}
+
+// Takes group o's members (and warm impulses) into g, which becomes granular.
+static void merge_into(Group& g, Group& o) {
+  to_granular(g);
+  g.members.insert(g.members.end(), o.members.begin(), o.members.end());
+  g.acc.insert(g.acc.end(), o.acc.begin(), o.acc.end());
+  g.warm.insert(g.warm.end(), o.warm.begin(), o.warm.end());
+  std::sort(g.warm.begin(), g.warm.end(),
+            [](const World::GranularWarm& l, const World::GranularWarm& r) { return l.key < r.key; });
+  if (g.warm_h == 0.0) g.warm_h = o.warm_h;
+  o.members.clear();
+  o.acc.clear();
+}
+
+bool plan_group_reach(const World& w, const std::vector<std::uint32_t>& members, double dt, std::size_t limit,
+                      std::ptrdiff_t exclude_group, std::vector<std::uint32_t>& add, std::vector<std::size_t>& merge,
+                      bool statics_ok) {
+  add.clear();
+  merge.clear();
+  const std::size_t N = w.size();
+  thread_local std::vector<std::int32_t> gid;
+  thread_local std::vector<char> in;
+  gid.assign(N, -1);
+  in.assign(N, 0);
+  for (std::size_t k = 0; k < w.contact_groups.size(); ++k) {
+    for (std::uint32_t m : w.contact_groups[k].members) gid[m] = static_cast<std::int32_t>(k);
   }
-  if (members.size() < 2 || members.size() > kMaxMembers) return false;
+  double ascale = 0.0, vmax = 0.0;
+  for (std::uint32_t m : members) {
+    in[m] = 1;
+    ascale = std::max(ascale, w.acc.empty() ? 0.0 : length(w.acc[m]));
+    vmax = std::max(vmax, length(w.vel[m]));
+  }
+  // A member's reach: its own (speed, force, a contact's push); in a granular group an impulse
+  // may pass a body up to twice the group's fastest speed, so every member gets that.
+  const auto member_reach = [&](std::uint32_t m) {
+    const double own = reach_of(w, m, dt, ascale);
+    return statics_ok ? std::max(own, 2.0 * vmax * dt + 5.0 * ascale * dt * dt) : own;
+  };
+  std::size_t total = members.size();
+  const double tol = 1e-9 * w.length_scale;
+  std::vector<std::uint32_t> frontier = members, next;
+  while (!frontier.empty()) {
+    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+    for (std::uint32_t m : frontier) {
+      const double r = w.radius[m] + member_reach(m);
+      x0 = std::min(x0, w.pos[m].x - r);
+      y0 = std::min(y0, w.pos[m].y - r);
+      x1 = std::max(x1, w.pos[m].x + r);
+      y1 = std::max(y1, w.pos[m].y + r);
+    }
+    next.clear();
+    for (std::uint32_t j = 0; j < N; ++j) {
+      if (in[j]) continue;
+      const bool other = gid[j] >= 0 && gid[j] != exclude_group;
+      if (!w.alive(j) && !other) continue;
+      const double rj = w.radius[j] + reach_of(w, j, dt, ascale) + tol;
+      const Vec2 pj = w.pos[j];
+      if (pj.x + rj < x0 || pj.x - rj > x1 || pj.y + rj < y0 || pj.y - rj > y1) continue;
+      // (boxes, not circles: the check after the step, check_reach, compares boxes)
+      bool near = false;
+      for (std::uint32_t m : frontier) {
+        const double rm = w.radius[m] + member_reach(m);
+        if (std::fabs(pj.x - w.pos[m].x) <= rm + rj && std::fabs(pj.y - w.pos[m].y) <= rm + rj) {
+          near = true;
+          break;
+        }
+      }
+      if (!near) continue;
+      if (w.is_static(j)) {   // a fixed contact of a granular group; the exact mode has none
+        if (statics_ok) continue;
+        return false;
+      }
+      if (other) {   // a group within reach: merged whole
+        const std::size_t k = static_cast<std::size_t>(gid[j]);
+        merge.push_back(k);
+        for (std::uint32_t m : w.contact_groups[k].members) {
+          in[m] = 1;
+          next.push_back(m);
+          ++total;
+        }
+        if (total > limit) return false;
+        continue;
+      }
+      if (!w.dynamic(j) || j >= w.scene_bodies || (w.flags[j] & (kPoint | kParticle | kDestroyOnHit)) != 0) return false;
+      if (w.riding(j)) return false;
+      in[j] = 1;
+      add.push_back(j);
+      next.push_back(j);
+      if (++total > limit) return false;
+    }
+    frontier.swap(next);
+  }
+  return true;
+}
+
+bool engage_contact_group(World& w, std::span<const std::uint32_t> members) {
+  if (!contact_groups_allowed(w)) return false;
+  if (members.size() < 2) return false;
   for (std::uint32_t m : members) {
     if (!w.dynamic(m) || m >= w.scene_bodies || (w.flags[m] & (kPoint | kParticle | kDestroyOnHit)) != 0) return false;
     if (w.riding(m)) return false;
@@ -611,7 +720,14 @@ bool engage_contact_group(World& w, std::span<const std::uint32_t> members) {
   Group g;
   g.members.assign(members.begin(), members.end());
   std::vector<std::uint32_t> add;
-  if (!plan_absorb(w, g.members, w.group_dt, add)) return false;
+  std::vector<std::size_t> merge;
+  // The exact group mode up to kMaxMembers bodies, nothing static or another group within
+  // reach; a larger group is granular (granular.cpp).
+  bool granular = members.size() > kMaxMembers ||
+                  !plan_group_reach(w, g.members, w.group_dt, kMaxMembers, -1, add, merge, false) || !merge.empty();
+  if (granular && !plan_group_reach(w, g.members, w.group_dt, static_cast<std::size_t>(-1), -1, add, merge, true)) {
+    return false;
+  }
   for (std::uint32_t m : g.members) {
     release_support(w, m);
     // bodies resting on a member are released too (judged free next step)
@@ -623,16 +739,20 @@ bool engage_contact_group(World& w, std::span<const std::uint32_t> members) {
     ++w.version[m];
     g.acc.push_back(w.acc[m]);
   }
-  for (std::size_t p = 0; p < g.members.size(); ++p) {
-    for (std::size_t q = p + 1; q < g.members.size(); ++q) {
-      const PairMaterial m = w.pair_material(w.material[g.members[p]], w.material[g.members[q]]);
-      GC k;
-      k.a = static_cast<std::int32_t>(p);
-      k.b = static_cast<std::int32_t>(q);
-      k.mu_k = m.friction;
-      k.mu_s = std::max(m.friction, m.static_friction);
-      k.e = m.restitution;
-      g.contacts.push_back(k);
+  if (granular) {
+    to_granular(g);
+  } else {
+    for (std::size_t p = 0; p < g.members.size(); ++p) {
+      for (std::size_t q = p + 1; q < g.members.size(); ++q) {
+        const PairMaterial m = w.pair_material(w.material[g.members[p]], w.material[g.members[q]]);
+        GC k;
+        k.a = static_cast<std::int32_t>(p);
+        k.b = static_cast<std::int32_t>(q);
+        k.mu_k = m.friction;
+        k.mu_s = std::max(m.friction, m.static_friction);
+        k.e = m.restitution;
+        g.contacts.push_back(k);
+      }
     }
   }
   g.fresh = true;
@@ -642,46 +762,13 @@ bool engage_contact_group(World& w, std::span<const std::uint32_t> members) {
   }
   if (w.group_first_time < 0.0) w.group_first_time = w.time;
   apply_absorb(w, g, add);   // free bodies that may meet it in this step join it
+  std::sort(merge.begin(), merge.end());
+  for (std::size_t k = merge.size(); k-- > 0;) {
+    merge_into(g, w.contact_groups[merge[k]]);
+    w.contact_groups.erase(w.contact_groups.begin() + static_cast<std::ptrdiff_t>(merge[k]));
+  }
   w.contact_groups.push_back(std::move(g));
   set_alive(w, w.contact_groups.back(), false);
-  return true;
-}
-
-// How far body i can go in a step of dt (its speed, its force and a contact's push).
-static double reach_of(const World& w, std::uint32_t i, double dt, double ascale) {
-  const double a = w.acc.empty() ? 0.0 : length(w.acc[i]);
-  return length(w.vel[i]) * dt + (a + 4.0 * ascale) * dt * dt;
-}
-
-// The bodies that may meet the group (members `members`) within a step of dt, transitively:
-// each must be able to join it (a free scene body, no particle, point or body on a cap, in no
-// other group) and the group stays within kMaxMembers; else false (core cannot run the group
-// there: it finds no impacts of other bodies with a group).
-static bool plan_absorb(const World& w, const std::vector<std::uint32_t>& members, double dt,
-                        std::vector<std::uint32_t>& add) {
-  add.clear();
-  double ascale = 0.0;
-  for (std::uint32_t m : members) ascale = std::max(ascale, w.acc.empty() ? 0.0 : length(w.acc[m]));
-  std::vector<std::uint32_t> all = members;
-  for (std::size_t q = 0; q < all.size(); ++q) {
-    const std::uint32_t m = all[q];
-    const double rm = w.radius[m] + reach_of(w, m, dt, ascale);
-    for (std::uint32_t j = 0; j < w.size(); ++j) {
-      if (std::find(all.begin(), all.end(), j) != all.end()) continue;
-      bool in_other = false;
-      for (const Group& h : w.contact_groups) {
-        in_other = in_other || (&h.members != &members && std::find(h.members.begin(), h.members.end(), j) != h.members.end());
-      }
-      if (!w.alive(j) && !in_other) continue;
-      const double R = rm + w.radius[j] + reach_of(w, j, dt, ascale) + 1e-9 * w.length_scale;
-      if (length(w.pos[j] - w.pos[m]) > R) continue;
-      if (!w.dynamic(j) || j >= w.scene_bodies || (w.flags[j] & (kPoint | kParticle | kDestroyOnHit)) != 0) return false;
-      if (w.riding(j) || in_other) return false;
-      all.push_back(j);
-      add.push_back(j);
-      if (all.size() > kMaxMembers) return false;
-    }
-  }
   return true;
 }
 
@@ -694,16 +781,18 @@ static void apply_absorb(World& w, Group& g, const std::vector<std::uint32_t>& a
       if (w.supported(d)) release_support(w, d);
     }
     ++w.version[j];
-    const std::int32_t nj = static_cast<std::int32_t>(g.members.size());
-    for (std::size_t p = 0; p < g.members.size(); ++p) {
-      const PairMaterial mat = w.pair_material(w.material[g.members[p]], w.material[j]);
-      GC k;
-      k.a = static_cast<std::int32_t>(p);
-      k.b = nj;
-      k.mu_k = mat.friction;
-      k.mu_s = std::max(mat.friction, mat.static_friction);
-      k.e = mat.restitution;
-      g.contacts.push_back(k);
+    if (!g.granular) {
+      const std::int32_t nj = static_cast<std::int32_t>(g.members.size());
+      for (std::size_t p = 0; p < g.members.size(); ++p) {
+        const PairMaterial mat = w.pair_material(w.material[g.members[p]], w.material[j]);
+        GC k;
+        k.a = static_cast<std::int32_t>(p);
+        k.b = nj;
+        k.mu_k = mat.friction;
+        k.mu_s = std::max(mat.friction, mat.static_friction);
+        k.e = mat.restitution;
+        g.contacts.push_back(k);
+      }
     }
     g.members.push_back(j);
     g.acc.push_back(w.acc[j]);
@@ -713,25 +802,46 @@ static void apply_absorb(World& w, Group& g, const std::vector<std::uint32_t>& a
 
 void hide_contact_groups(World& w, const StepContext& ctx) {
   w.group_dt = ctx.dt;
-  // A body that may meet a group in this step joins it; where one cannot, the group is given
-  // back to the engine (its members free, at their state) and the run reports a broken
-  // guarantee: core cannot run that group.
+  // A body that may meet a group in this step joins it (a group within reach merges with it);
+  // where one cannot, the group is given back to the engine (its members free, at their
+  // state) and the run reports a broken guarantee: core cannot run that group.
   std::vector<std::uint32_t> add;
-  std::vector<Group> keep;
+  std::vector<std::size_t> merge;
   for (Group& g : w.contact_groups) set_alive(w, g, true);
+  std::vector<char> gone(w.contact_groups.size(), 0);
+  const std::size_t unlimited = static_cast<std::size_t>(-1);
   for (std::size_t q = 0; q < w.contact_groups.size(); ++q) {
+    if (gone[q]) continue;
     Group& g = w.contact_groups[q];
-    if (w.group_disturbed == kNone && plan_absorb(w, g.members, ctx.dt, add)) {
+    const auto self = static_cast<std::ptrdiff_t>(q);
+    bool ok = false;
+    if (w.group_disturbed == kNone) {
+      ok = plan_group_reach(w, g.members, ctx.dt, g.granular ? unlimited : kMaxMembers, self, add, merge, g.granular);
+      if (!ok && !g.granular && plan_group_reach(w, g.members, ctx.dt, unlimited, self, add, merge, true)) {
+        to_granular(g);   // over kMaxMembers, or something static within reach: granular from here
+        ok = true;
+      }
+    }
+    if (ok) {
+      if (!merge.empty()) to_granular(g);
       apply_absorb(w, g, add);
-      keep.push_back(std::move(g));
+      for (std::size_t k : merge) {
+        if (k == q || gone[k]) continue;
+        merge_into(g, w.contact_groups[k]);
+        gone[k] = 1;
+      }
       continue;
     }
+    gone[q] = 1;
     if (w.group_disturbed == kNone) {
       w.group_disturbed = g.members.front();
       w.group_disturbed_time = ctx.t0;
-      w.group_why = "a body that may meet it cannot join it (static, a particle or point, on a corner's cap, in another "
-                    "group, or over 16 members)";
+      w.group_why = "a body that may meet it cannot join it (a particle or point, or on a corner's cap)";
     }
+  }
+  std::vector<Group> keep;
+  for (std::size_t q = 0; q < w.contact_groups.size(); ++q) {
+    if (!gone[q]) keep.push_back(std::move(w.contact_groups[q]));
   }
   w.contact_groups = std::move(keep);
   for (const Group& g : w.contact_groups) set_alive(w, g, false);
@@ -739,204 +849,322 @@ void hide_contact_groups(World& w, const StepContext& ctx) {
   w.group_v0 = w.vel;
 }
 
+// Anything else within reach of a group's swept box after its step: core does not find
+// impacts of other bodies with a group (a broken guarantee, as for a body riding a corner's cap).
+// With member_boxes (a granular group's, 4 numbers a member), a body must reach one member's box.
+static void check_reach(World& w, const Box& swept, const StepContext& ctx, double scale,
+                        const std::vector<double>* member_boxes = nullptr) {
+  const double tol = 1e-9 * scale;
+  for (std::uint32_t j = 0; j < w.size() && w.group_disturbed == kNone; ++j) {
+    if (!w.alive(j)) continue;
+    const Vec2 p0 = w.group_p0[j], p1 = w.pos[j];
+    const Vec2 p2 = p0 + ctx.dt * w.group_v0[j];
+    const double r = w.radius[j] + (w.acc.empty() ? 0.0 : length(w.acc[j])) * ctx.dt * ctx.dt + tol;
+    const Box bj{std::min({p0.x, p1.x, p2.x}) - r, std::min({p0.y, p1.y, p2.y}) - r,
+                 std::max({p0.x, p1.x, p2.x}) + r, std::max({p0.y, p1.y, p2.y}) + r};
+    bool hit = bj.overlaps(swept);
+    if (hit && member_boxes != nullptr) {
+      hit = false;
+      for (std::size_t q = 0; 4 * q < member_boxes->size() && !hit; ++q) {
+        const double* b = &(*member_boxes)[4 * q];
+        hit = bj.overlaps(Box{b[0], b[1], b[2], b[3]});
+      }
+    }
+    if (hit) {
+      w.group_disturbed = j;
+      w.group_disturbed_time = ctx.t0;
+      w.group_why = "body '" + w.name(j) + "' came within reach of it (core finds no impacts of other bodies with a group)";
+    }
+  }
+}
+
+// A granular group's step (granular.cpp), then its split.
+static void advance_granular(World& w, Group& g, const StepContext& ctx, std::vector<Group>& next, Box& swept) {
+  std::vector<Vec2> p0, v0;
+  for (std::uint32_t m : g.members) {
+    p0.push_back(w.pos[m]);
+    v0.push_back(w.vel[m]);
+  }
+  std::vector<double> boxes;
+  const bool was_disturbed = w.group_disturbed != kNone;
+  granular_step(w, g, ctx, boxes);
+  swept = Box{};
+  for (std::size_t q = 0; 4 * q < boxes.size(); ++q) swept.add(Box{boxes[4 * q], boxes[4 * q + 1], boxes[4 * q + 2], boxes[4 * q + 3]});
+  check_reach(w, swept, ctx, w.length_scale, &boxes);
+  if (!was_disturbed && w.group_disturbed != kNone) {   // undone: the engine takes them back
+    for (std::size_t q = 0; q < g.members.size(); ++q) {
+      w.pos[g.members[q]] = p0[q];
+      w.vel[g.members[q]] = v0[q];
+    }
+  }
+  granular_split(w, g, ctx.dt, next);
+}
+
+// One group's step (exact or granular); the groups it splits into are appended to `next`,
+// the box its members swept to swept_out.
+static void step_group(World& w, Group& g, const StepContext& ctx, std::vector<Group>& next, Box& swept_out) {
+  if (g.granular) {
+    advance_granular(w, g, ctx, next, swept_out);
+    return;
+  }
+  bool convert = false;   // the exact mode cannot take this step: granular from here
+  Ctx c = make_ctx(w, g);
+  State s;
+  load_state(g, w, s);
+  const State s_start = s;
+  const bool was_disturbed = w.group_disturbed != kNone;
+  double vmax = 0.0;
+  for (const Vec2& q : s.v) vmax = std::max(vmax, length(q));
+  double pad = vmax * ctx.dt + 4.0 * c.ascale * ctx.dt * ctx.dt + 1e-9 * c.scale;
+  Box swept;
+  std::vector<GEvent> evs;
+  for (int attempt = 0; attempt < 8; ++attempt) {
+    s = s_start;
+    const Box qbox = box_of(w, g.members, s, pad);
+    if (!refresh_faces(w, g, make_aabb(qbox.x0, qbox.y0, qbox.x1, qbox.y1)) && w.group_disturbed == kNone) {
+      w.group_disturbed = g.members.front();
+      w.group_disturbed_time = ctx.t0;
+      w.group_why = "a face near it has interpolated normals (a surface), which the mode does not model";
+    }
+    if (g.fresh || attempt > 0) {
+      select_active(c, s.x, s.v, g.contacts.size());
+      g.fresh = false;
+    }
+    swept = box_of(w, g.members, s, 0.0);
+    const double h0 = ctx.dt / kSubsteps;
+    double t = 0.0;
+    int events = 0;
+    for (int sub = 1; sub <= kSubsteps && !convert; ++sub) {
+      const double t_end = ctx.dt * sub / kSubsteps;
+      while (t < t_end && !convert) {
+        const double h = t_end - t;
+        std::vector<double> gap0(g.contacts.size());
+        for (std::size_t k = 0; k < g.contacts.size(); ++k) gap0[k] = geometry(c, g.contacts[k], s.x).gap;
+        State e = rk4(c, s, h);
+        events_at(c, e, gap0, evs);
+        double tau = h;
+        GEvent first{Ev::Impact, g.contacts.size()};
+        if (!evs.empty() && events < kMaxEventsPerStep) {
+          for (const GEvent& ev : evs) {   // the earliest, by bisection on the sub-step's RK4 state
+            double lo = 0.0, hi = tau;
+            if (!happened(c, rk4(c, s, hi), ev)) continue;
+            for (int it = 0; it < 200 && hi - lo > 1e-15 * h0; ++it) {
+              const double mid = 0.5 * (lo + hi);
+              if (happened(c, rk4(c, s, mid), ev)) {
+                hi = mid;
+              } else {
+                lo = mid;
+              }
+            }
+            if (hi < tau || first.k == g.contacts.size()) {
+              tau = hi;
+              first = ev;
+            }
+          }
+          e = rk4(c, s, tau);
+        } else if (!evs.empty()) {
+          convert = true;   // more events than a step may take (impacts that cycle)
+        }
+        double vm = 0.0;
+        for (const Vec2& q : e.v) vm = std::max(vm, length(q));
+        swept.add(box_of(w, g.members, e, vm * tau));
+        project(c, e);
+        s = e;
+        t = tau >= h ? t_end : t + tau;
+        if (first.k < g.contacts.size()) {
+          ++events;
+          ++w.group_events;
+          std::size_t exclude = g.contacts.size();
+          if (first.kind == Ev::LiftOff) exclude = first.k;
+          if (first.kind == Ev::Stop) g.contacts[first.k].slip = 0.0;
+          if (first.kind == Ev::Impact) {   // a contact begins (or continues, within a step)
+            const GC& kk = g.contacts[first.k];
+            const std::uint32_t mb = g.members[static_cast<std::size_t>(kk.b)];
+            if (kk.a >= 0) {
+              record_contact(w, mb, g.members[static_cast<std::size_t>(kk.a)], nullptr, ctx.t0 + t, ctx.dt);
+            } else {
+              record_contact(w, mb, kNone, &w.statics.segments[kk.seg], ctx.t0 + t, ctx.dt);
+            }
+          }
+          if (first.kind == Ev::Impact && !impact(c, s, first.k)) {
+            convert = true;   // an impulse on a sliding contact with friction: not modelled here
+          }
+          select_active(c, s.x, s.v, exclude);
+        }
+      }
+    }
+    if (convert || qbox.contains(swept)) break;
+    pad *= 4.0;
+  }
+  if (convert && contact_groups_allowed(w)) {   // the step again, granular (nothing written yet)
+    to_granular(g);
+    advance_granular(w, g, ctx, next, swept_out);
+    return;
+  }
+  if (convert && w.group_disturbed == kNone) {
+    w.group_disturbed = g.members.front();
+    w.group_disturbed_time = ctx.t0;
+    w.group_why = "the exact group mode could not take its step (impacts that cycle, or an impulse on a sliding "
+                  "contact with friction)";
+  }
+  check_reach(w, swept, ctx, c.scale);
+  swept_out = swept;
+  // The mode failed in this step (a broken guarantee is reported): the group's step is undone
+  // (its members at their state at the step's start, which overlaps nothing) and the engine
+  // takes them back at the step's end.
+  if (!was_disturbed && w.group_disturbed != kNone) {
+    s = s_start;
+  } else if (w.group_disturbed == kNone) {
+    ++w.group_steps;
+  }
+  // Contacts touching at the step's end continue (no new contact event when the engine
+  // takes the bodies back).
+  for (const GC& k : g.contacts) {
+    if (!k.active && geometry(c, k, s.x).gap > 1e-9 * c.scale) continue;
+    const std::uint32_t mb = g.members[static_cast<std::size_t>(k.b)];
+    touch_contact(w, mb, k.a >= 0 ? g.members[static_cast<std::size_t>(k.a)]
+                                  : static_partner_key(w.statics.segments[k.seg].owner),
+                  ctx.t0 + ctx.dt);
+  }
+  for (std::size_t q = 0; q < g.members.size(); ++q) {
+    const std::uint32_t m = g.members[q];
+    w.pos[m] = s.x[q];
+    w.vel[m] = s.v[q];
+    w.tloc[m] = 0.0;
+    w.apath[m] = w.acc[m];
+    ++w.version[m];
+  }
+  // Split: members touching (transitively) stay a group; a member touching none leaves it.
+  // A group at rest (every speed 0 and its contacts hold it) leaves whole, to the hold.
+  const std::size_t M = g.members.size();
+  std::vector<std::size_t> comp(M);
+  std::iota(comp.begin(), comp.end(), 0);
+  const auto find = [&](std::size_t a) {
+    while (comp[a] != a) a = comp[a] = comp[comp[a]];
+    return a;
+  };
+  for (const GC& k : g.contacts) {
+    if (k.a < 0) continue;
+    // members that may meet within the next step stay together (its reach from their state now)
+    const std::uint32_t ma = g.members[static_cast<std::size_t>(k.a)], mb = g.members[static_cast<std::size_t>(k.b)];
+    const double reach = reach_of(w, ma, ctx.dt, c.ascale) + reach_of(w, mb, ctx.dt, c.ascale) + 1e-9 * c.scale;
+    if (k.active || geometry(c, k, s.x).gap <= reach) {
+      comp[find(static_cast<std::size_t>(k.a))] = find(static_cast<std::size_t>(k.b));
+    }
+  }
+  bool at_rest = true;
+  for (const Vec2& q : s.v) at_rest = at_rest && length(q) <= 1e-12 * (c.ascale * ctx.dt + 1e-300);
+  if (at_rest) {
+    Solution sol;
+    bilateral(c, s.x, s.v, sol);
+    for (const Vec2& a : sol.acc) at_rest = at_rest && length(a) <= 1e-9 * c.ascale;
+  }
+  std::vector<char> done(M, 0);
+  for (std::size_t q = 0; q < M; ++q) {
+    if (done[q]) continue;
+    std::vector<std::size_t> part;
+    for (std::size_t p = 0; p < M; ++p) {
+      if (find(p) == find(q)) {
+        part.push_back(p);
+        done[p] = 1;
+      }
+    }
+    if (part.size() < 2 || at_rest) {
+      for (std::size_t p : part) {
+        const std::uint32_t m = g.members[p];
+        w.flags[m] = static_cast<std::uint8_t>(w.flags[m] | kAlive);
+        if (at_rest) w.vel[m] = {};
+      }
+      continue;
+    }
+    Group h;
+    std::vector<std::int32_t> map(M, -1);
+    for (std::size_t p : part) {
+      map[p] = static_cast<std::int32_t>(h.members.size());
+      h.members.push_back(g.members[p]);
+      h.acc.push_back(g.acc[p]);
+    }
+    for (GC k : g.contacts) {
+      if (map[static_cast<std::size_t>(k.b)] < 0) continue;
+      if (k.a >= 0 && map[static_cast<std::size_t>(k.a)] < 0) continue;
+      k.b = map[static_cast<std::size_t>(k.b)];
+      if (k.a >= 0) k.a = map[static_cast<std::size_t>(k.a)];
+      h.contacts.push_back(k);
+    }
+    h.fresh = part.size() != M;
+    next.push_back(std::move(h));
+  }
+}
+
 void advance_contact_groups(World& w, const StepContext& ctx) {
   w.group_dt = ctx.dt;
   std::vector<Group> next;
-  for (Group& g : w.contact_groups) {
-    Ctx c = make_ctx(w, g);
-    State s;
-    load_state(g, w, s);
-    const State s_start = s;
-    const bool was_disturbed = w.group_disturbed != kNone;
-    double vmax = 0.0;
-    for (const Vec2& q : s.v) vmax = std::max(vmax, length(q));
-    double pad = vmax * ctx.dt + 4.0 * c.ascale * ctx.dt * ctx.dt + 1e-9 * c.scale;
+  // Each group steps alone, hidden from the others: two whose members came within reach of
+  // each other in the step (an impulse sped one up past the reach they were planned with) are
+  // taken back to the step's start and stepped again as one granular group.
+  struct Stepped {
+    std::vector<std::uint32_t> members;
+    std::size_t first = 0, end = 0;          // its groups in `next`
+    std::size_t ev_first = 0, ev_end = 0;    // its contact events in w.contacts
     Box swept;
-    std::vector<GEvent> evs;
-    for (int attempt = 0; attempt < 8; ++attempt) {
-      s = s_start;
-      const Box qbox = box_of(w, g.members, s, pad);
-      if (!refresh_faces(w, g, make_aabb(qbox.x0, qbox.y0, qbox.x1, qbox.y1)) && w.group_disturbed == kNone) {
-        w.group_disturbed = g.members.front();
-        w.group_disturbed_time = ctx.t0;
-        w.group_why = "a face near it has interpolated normals (a surface), which the mode does not model";
-      }
-      if (g.fresh || attempt > 0) {
-        select_active(c, s.x, s.v, g.contacts.size());
-        g.fresh = false;
-      }
-      swept = box_of(w, g.members, s, 0.0);
-      const double h0 = ctx.dt / kSubsteps;
-      double t = 0.0;
-      int events = 0;
-      for (int sub = 1; sub <= kSubsteps; ++sub) {
-        const double t_end = ctx.dt * sub / kSubsteps;
-        while (t < t_end) {
-          const double h = t_end - t;
-          std::vector<double> gap0(g.contacts.size());
-          for (std::size_t k = 0; k < g.contacts.size(); ++k) gap0[k] = geometry(c, g.contacts[k], s.x).gap;
-          State e = rk4(c, s, h);
-          events_at(c, e, gap0, evs);
-          double tau = h;
-          GEvent first{Ev::Impact, g.contacts.size()};
-          if (!evs.empty() && events < kMaxEventsPerStep) {
-            for (const GEvent& ev : evs) {   // the earliest, by bisection on the sub-step's RK4 state
-              double lo = 0.0, hi = tau;
-              if (!happened(c, rk4(c, s, hi), ev)) continue;
-              for (int it = 0; it < 200 && hi - lo > 1e-15 * h0; ++it) {
-                const double mid = 0.5 * (lo + hi);
-                if (happened(c, rk4(c, s, mid), ev)) {
-                  hi = mid;
-                } else {
-                  lo = mid;
-                }
-              }
-              if (hi < tau || first.k == g.contacts.size()) {
-                tau = hi;
-                first = ev;
-              }
-            }
-            e = rk4(c, s, tau);
-          } else if (!evs.empty() && w.group_disturbed == kNone) {
-            w.group_disturbed = g.members.front();   // more events than a step may take
-            w.group_disturbed_time = ctx.t0 + t;
-            w.group_why = "its events in one step passed the mode's limit (impacts that cycle)";
-          }
-          double vm = 0.0;
-          for (const Vec2& q : e.v) vm = std::max(vm, length(q));
-          swept.add(box_of(w, g.members, e, vm * tau));
-          project(c, e);
-          s = e;
-          t = tau >= h ? t_end : t + tau;
-          if (first.k < g.contacts.size()) {
-            ++events;
-            ++w.group_events;
-            std::size_t exclude = g.contacts.size();
-            if (first.kind == Ev::LiftOff) exclude = first.k;
-            if (first.kind == Ev::Stop) g.contacts[first.k].slip = 0.0;
-            if (first.kind == Ev::Impact) {   // a contact begins (or continues, within a step)
-              const GC& kk = g.contacts[first.k];
-              const std::uint32_t mb = g.members[static_cast<std::size_t>(kk.b)];
-              if (kk.a >= 0) {
-                record_contact(w, mb, g.members[static_cast<std::size_t>(kk.a)], nullptr, ctx.t0 + t, ctx.dt);
-              } else {
-                record_contact(w, mb, kNone, &w.statics.segments[kk.seg], ctx.t0 + t, ctx.dt);
-              }
-            }
-            if (first.kind == Ev::Impact && !impact(c, s, first.k) && w.group_disturbed == kNone) {
-              w.group_disturbed = g.members[static_cast<std::size_t>(g.contacts[first.k].b)];
-              w.group_disturbed_time = ctx.t0 + t;
-              w.group_why = "an impact in it put an impulse on a sliding contact with friction, which the mode does not model";
-            }
-            select_active(c, s.x, s.v, exclude);
-          }
+    bool live = true;
+  };
+  std::vector<Stepped> done;
+  const auto run = [&](Group& g) {
+    Stepped st;
+    st.members = g.members;
+    st.first = next.size();
+    st.ev_first = w.contacts.size();
+    step_group(w, g, ctx, next, st.swept);
+    st.end = next.size();
+    st.ev_end = w.contacts.size();
+    done.push_back(std::move(st));
+  };
+  for (Group& g : w.contact_groups) run(g);
+  std::vector<char> drop_event;
+  const double tol = 1e-9 * w.length_scale;
+  for (std::size_t guard = 0; guard < 4 * done.size() + 4 && w.group_disturbed == kNone; ++guard) {
+    std::size_t i = done.size(), j = done.size();
+    for (std::size_t p = 0; p < done.size() && i == done.size(); ++p) {
+      if (!done[p].live) continue;
+      for (std::size_t q = p + 1; q < done.size(); ++q) {
+        if (!done[q].live) continue;
+        const Box& A = done[p].swept;
+        const Box& B = done[q].swept;
+        if (A.x0 <= B.x1 + tol && B.x0 <= A.x1 + tol && A.y0 <= B.y1 + tol && B.y0 <= A.y1 + tol) {
+          i = p;
+          j = q;
+          break;
         }
       }
-      if (qbox.contains(swept)) break;
-      pad *= 4.0;
     }
-    // Anything else within reach of the group's swept box: core does not find impacts of other
-    // bodies with a group (a broken guarantee, as for a body riding a corner's cap).
-    const double tol = 1e-9 * c.scale;
-    for (std::uint32_t j = 0; j < w.size() && w.group_disturbed == kNone; ++j) {
-      if (!w.alive(j)) continue;
-      const Vec2 p0 = w.group_p0[j], p1 = w.pos[j];
-      const Vec2 p2 = p0 + ctx.dt * w.group_v0[j];
-      const double r = w.radius[j] + (w.acc.empty() ? 0.0 : length(w.acc[j])) * ctx.dt * ctx.dt + tol;
-      const Box bj{std::min({p0.x, p1.x, p2.x}) - r, std::min({p0.y, p1.y, p2.y}) - r,
-                   std::max({p0.x, p1.x, p2.x}) + r, std::max({p0.y, p1.y, p2.y}) + r};
-      if (bj.overlaps(swept)) {
-        w.group_disturbed = j;
-        w.group_disturbed_time = ctx.t0;
-        w.group_why = "body '" + w.name(j) + "' came within reach of it (core finds no impacts of other bodies with a group)";
+    if (i == done.size()) break;
+    Group merged;
+    merged.granular = true;
+    merged.fresh = true;
+    for (std::size_t k : {i, j}) {
+      Stepped& st = done[k];
+      st.live = false;
+      for (std::size_t c = st.first; c < st.end; ++c) next[c].members.clear();   // undone
+      if (drop_event.size() < w.contacts.size()) drop_event.resize(w.contacts.size(), 0);
+      for (std::size_t e = st.ev_first; e < st.ev_end; ++e) drop_event[e] = 1;
+      for (std::uint32_t m : st.members) {
+        w.pos[m] = w.group_p0[m];
+        w.vel[m] = w.group_v0[m];
+        w.tloc[m] = 0.0;
+        w.apath[m] = w.acc[m];
+        ++w.version[m];
+        merged.members.push_back(m);
+        merged.acc.push_back(w.acc[m]);
       }
     }
-    // The mode failed in this step (a broken guarantee is reported): the group's step is undone
-    // (its members at their state at the step's start, which overlaps nothing) and the engine
-    // takes them back at the step's end.
-    if (!was_disturbed && w.group_disturbed != kNone) {
-      s = s_start;
-    } else if (w.group_disturbed == kNone) {
-      ++w.group_steps;
-    }
-    // Contacts touching at the step's end continue (no new contact event when the engine
-    // takes the bodies back).
-    for (const GC& k : g.contacts) {
-      if (!k.active && geometry(c, k, s.x).gap > 1e-9 * c.scale) continue;
-      const std::uint32_t mb = g.members[static_cast<std::size_t>(k.b)];
-      touch_contact(w, mb, k.a >= 0 ? g.members[static_cast<std::size_t>(k.a)]
-                                    : static_partner_key(w.statics.segments[k.seg].owner),
-                    ctx.t0 + ctx.dt);
-    }
-    for (std::size_t q = 0; q < g.members.size(); ++q) {
-      const std::uint32_t m = g.members[q];
-      w.pos[m] = s.x[q];
-      w.vel[m] = s.v[q];
-      w.tloc[m] = 0.0;
-      w.apath[m] = w.acc[m];
-      ++w.version[m];
-    }
-    // Split: members touching (transitively) stay a group; a member touching none leaves it.
-    // A group at rest (every speed 0 and its contacts hold it) leaves whole, to the hold.
-    const std::size_t M = g.members.size();
-    std::vector<std::size_t> comp(M);
-    std::iota(comp.begin(), comp.end(), 0);
-    const auto find = [&](std::size_t a) {
-      while (comp[a] != a) a = comp[a] = comp[comp[a]];
-      return a;
-    };
-    for (const GC& k : g.contacts) {
-      if (k.a < 0) continue;
-      // members that may meet within the next step stay together (its reach from their state now)
-      const std::uint32_t ma = g.members[static_cast<std::size_t>(k.a)], mb = g.members[static_cast<std::size_t>(k.b)];
-      const double reach = reach_of(w, ma, ctx.dt, c.ascale) + reach_of(w, mb, ctx.dt, c.ascale) + 1e-9 * c.scale;
-      if (k.active || geometry(c, k, s.x).gap <= reach) {
-        comp[find(static_cast<std::size_t>(k.a))] = find(static_cast<std::size_t>(k.b));
-      }
-    }
-    bool at_rest = true;
-    for (const Vec2& q : s.v) at_rest = at_rest && length(q) <= 1e-12 * (c.ascale * ctx.dt + 1e-300);
-    if (at_rest) {
-      Solution sol;
-      bilateral(c, s.x, s.v, sol);
-      for (const Vec2& a : sol.acc) at_rest = at_rest && length(a) <= 1e-9 * c.ascale;
-    }
-    std::vector<char> done(M, 0);
-    for (std::size_t q = 0; q < M; ++q) {
-      if (done[q]) continue;
-      std::vector<std::size_t> part;
-      for (std::size_t p = 0; p < M; ++p) {
-        if (find(p) == find(q)) {
-          part.push_back(p);
-          done[p] = 1;
-        }
-      }
-      if (part.size() < 2 || at_rest) {
-        for (std::size_t p : part) {
-          const std::uint32_t m = g.members[p];
-          w.flags[m] = static_cast<std::uint8_t>(w.flags[m] | kAlive);
-          if (at_rest) w.vel[m] = {};
-        }
-        continue;
-      }
-      Group h;
-      std::vector<std::int32_t> map(M, -1);
-      for (std::size_t p : part) {
-        map[p] = static_cast<std::int32_t>(h.members.size());
-        h.members.push_back(g.members[p]);
-        h.acc.push_back(g.acc[p]);
-      }
-      for (GC k : g.contacts) {
-        if (map[static_cast<std::size_t>(k.b)] < 0) continue;
-        if (k.a >= 0 && map[static_cast<std::size_t>(k.a)] < 0) continue;
-        k.b = map[static_cast<std::size_t>(k.b)];
-        if (k.a >= 0) k.a = map[static_cast<std::size_t>(k.a)];
-        h.contacts.push_back(k);
-      }
-      h.fresh = part.size() != M;
-      next.push_back(std::move(h));
-    }
+    run(merged);
   }
+  if (!drop_event.empty()) {
+    std::size_t k = 0;
+    std::erase_if(w.contacts, [&](const ContactEvent&) { return k < drop_event.size() && drop_event[k++] != 0; });
+  }
+  std::erase_if(next, [](const Group& g) { return g.members.empty(); });
   w.contact_groups = std::move(next);
   for (const Group& g : w.contact_groups) set_alive(w, g, true);   // seen as alive between steps
   // The mode failed (a broken guarantee is reported): the engine takes the members back.

@@ -98,6 +98,8 @@ void CoreEngine::step(double dt) {
   if (!w.emitters.empty()) core_detail::finish_particles(w, ctx);
 
   w.time = ctx.t0 + dt;
+  // An impact storm in this step (a pile's inelastic collapse): its bodies become a granular group
+  if (!w.storm_bodies.empty()) core_detail::engage_storm_groups(w, ctx);
   // Holds made inside a step are judged at the next step's start (apply_supports), once
   // the supports are settled again. The run's last step has no next one: its holds are
   // judged at its end, so a hold made there is not `ok` unjudged (the same verdict and time
@@ -216,6 +218,18 @@ std::vector<std::string> CoreEngine::limits_hit() const {
        << w.group_events
        << " event(s)): a resting group core could not hold moved on its contact forces, integrated by RK4 on "
           "sub-steps of dt/8 and projected onto its contacts (order 4, not exact)";
+    out.push_back(os.str());
+  }
+  if (w.granular_steps > 0) {
+    std::ostringstream os;
+    os << "granular contact from t = " << w.granular_first_time << " s (" << w.granular_steps
+       << " group step(s)): bodies in persistent contact with several others (a pile, a collapse) moved by "
+          "nonsmooth contact dynamics (Moreau-Jean time stepping on sub-steps of dt/4, Signorini and Coulomb at the "
+          "velocity level solved at every contact at once, overlaps projected off): first order, not exact";
+    if (w.granular_unconverged > 0) {
+      os << "; " << w.granular_unconverged << " sub-step solve(s) stopped at the sweep limit (largest residual "
+         << w.granular_worst_residual << " m/s)";
+    }
     out.push_back(os.str());
   }
   if (w.cap_unmodelled > 0) {

@@ -65,7 +65,8 @@ class EventLoop {
         coupled_(w.coupled()),
         fast_isolated_(w.impact_law == ImpactLaw::Simultaneous && !w.any_rules && !w.any_forces && !w.varying_forces &&
                        !w.coupled()),
-        zeno_tails_(w.zeno_tails()) {
+        zeno_tails_(w.zeno_tails()),
+        storms_(contact_groups_allowed(w)) {
     // A few faces: their boxes, as StaticGeometry builds them, to skip its query for
     // a box that meets none (most bodies of a walled gas, away from the walls).
     if (w.statics.segments.size() <= kFewFaces) {
@@ -732,6 +733,7 @@ class EventLoop {
         closing = -vn;
         rest_vr = vr;
         if (m.restitution * std::max(0.0, -vn) < vr) {
+          if (storms_) note_storm_impact(w_, i, j);   // an impact storm makes a granular group
           // Pressed together and too slow to bounce clear. Onto a body at rest: come to
           // rest on it (a stack). Otherwise a micro-bounce with a flight of at least
           // ~1/8 step instead of endless impacts.
@@ -1446,6 +1448,7 @@ class EventLoop {
   // near is the pairwise law's, proven without the touching set (isolated_pair).
   const bool fast_isolated_;
   const bool zeno_tails_;   // World::zeno_tails
+  const bool storms_;       // contact groups allowed: pressed slow pair impacts are counted
   std::vector<Tail> tails_;
   Aabb found_box_i_, found_box_j_;   // the new paths' boxes isolated_pair/_static found
   static constexpr std::uint32_t kFewFaces = 8, kManyFaces = 0xffffffffu;

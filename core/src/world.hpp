@@ -288,11 +288,25 @@ struct World {
     bool active = false, sticking = false;
     double slip = 0.0;   // a sliding contact's direction of slip along perp(n), +-1; 0: none
   };
+  // A contact's impulses of a granular group's last sub-step (granular.cpp), by contact key:
+  // the next sub-step's projected Gauss-Seidel starts from them (warm start).
+  struct GranularWarm {
+    std::uint64_t key = 0;
+    double pn = 0.0, pt = 0.0;
+    bool slide = false;
+  };
   struct ContactGroup {
     std::vector<std::uint32_t> members;
     std::vector<Vec2> acc;   // the members' force accelerations (constant: no varying forces)
     std::vector<GroupContact> contacts;
     bool fresh = true;       // its active set is chosen at its next step's start
+    // Granular: moved by nonsmooth contact dynamics on sub-steps (granular.cpp) instead of
+    // the exact event-driven group solve: a group over kMaxMembers, one whose events cycle,
+    // or one engaged on an impact storm (a pile's inelastic collapse). `contacts` is unused.
+    bool granular = false;
+    bool sleeping = false;   // granular, at rest and held by its contacts: not stepped
+    std::vector<GranularWarm> warm;   // sorted by key
+    double warm_h = 0.0;              // the sub-step the warm impulses were found at
   };
   std::vector<ContactGroup> contact_groups;
   double group_dt = 0.0;
@@ -304,6 +318,13 @@ struct World {
   std::uint32_t group_disturbed = kNone;
   double group_disturbed_time = -1.0;
   std::string group_why;   // what it did not model
+  // Granular groups (granular.cpp): steps taken, sub-steps whose solve stopped at its
+  // sweep limit, the largest such residual (m/s), and the bodies whose pressed, slow pair
+  // impacts in the current step mark an impact storm (engage_storm_groups).
+  std::int64_t granular_steps = 0, granular_unconverged = 0;
+  double granular_first_time = -1.0, granular_worst_residual = 0.0;
+  std::vector<std::uint32_t> storm_count;   // per body, this step; empty when unused
+  std::vector<std::uint32_t> storm_bodies;  // bodies with a count to reset
 
   // ---- convex corners (convex_cap.cpp): bodies riding a segment end's cap, the circle of
   // radius r about the corner their centre moves on (a curved support), by body index.
@@ -726,6 +747,32 @@ void kill_body(World& w, std::uint32_t i);
 bool engage_contact_group(World& w, std::span<const std::uint32_t> members);
 void hide_contact_groups(World& w, const StepContext& ctx);
 void advance_contact_groups(World& w, const StepContext& ctx);
+// Whether the scene allows contact groups at all (exact impacts, constant forces, no rules,
+// emitters or Newtonian gravity).
+bool contact_groups_allowed(const World& w);
+
+// Granular groups (granular.cpp): nonsmooth contact dynamics (Moreau-Jean time stepping) on
+// sub-steps, the velocity-level Signorini-Coulomb problem solved by projected Gauss-Seidel to
+// round-off, positions projected off every overlap. Moves group g over the step, writes its
+// members' states to w, and the box each member swept to member_boxes (x0, y0, x1, y1 each).
+void granular_step(World& w, World::ContactGroup& g, const StepContext& ctx, std::vector<double>& member_boxes);
+// Splits a granular group after its step: members touching (transitively, within one step's
+// reach) stay together; a member touching no other leaves to the engine. Appends the groups
+// that stay to `out` (warm impulses kept).
+void granular_split(World& w, World::ContactGroup& g, double dt, std::vector<World::ContactGroup>& out);
+// An impact storm: a body met more than kStormImpacts times in one step by pressed, slow pair
+// impacts (the inelastic collapse of a pile) makes the bodies touching it, transitively, a
+// granular group at the step's end (where groups are allowed).
+inline constexpr std::uint32_t kStormImpacts = 24;
+void note_storm_impact(World& w, std::uint32_t i, std::uint32_t j);
+void engage_storm_groups(World& w, const StepContext& ctx);
+// The bodies that may meet a group (members `members`) within a step of dt, transitively:
+// appended to `add`; groups within reach to `merge` (indices into w.contact_groups). False
+// where one cannot join (a particle or point, a body on a corner's cap, or, when `limit` is
+// reached, too many). `exclude_group`: the group's own index (or -1).
+bool plan_group_reach(const World& w, const std::vector<std::uint32_t>& members, double dt, std::size_t limit,
+                      std::ptrdiff_t exclude_group, std::vector<std::uint32_t>& add, std::vector<std::size_t>& merge,
+                      bool statics_ok);
 
 // Pass-through pairs (collision matrix "event" and overlap tracking).
 std::uint64_t pair_key(std::uint32_t i, std::uint32_t j);
