@@ -602,7 +602,7 @@ bool contact_groups_allowed(const World& w) {
 
 // How far body i can go in a step of dt (its speed, its force and a contact's push).
 static double reach_of(const World& w, std::uint32_t i, double dt, double ascale) {
-  const double a = w.acc.empty() ? 0.0 : length(w.acc[i]);
+  const double a = w.acc.empty() ? 0.0 : length(group_force_acc(w, i));
   return length(w.vel[i]) * dt + (a + 4.0 * ascale) * dt * dt;
 }
 
@@ -642,7 +642,7 @@ bool plan_group_reach(const World& w, const std::vector<std::uint32_t>& members,
   double ascale = 0.0, vmax = 0.0;
   for (std::uint32_t m : members) {
     in[m] = 1;
-    ascale = std::max(ascale, w.acc.empty() ? 0.0 : length(w.acc[m]));
+    ascale = std::max(ascale, w.acc.empty() ? 0.0 : length(group_force_acc(w, m)));
     vmax = std::max(vmax, length(w.vel[m]));
   }
   // A member's reach: its own (speed, force, a contact's push); in a granular group an impulse
@@ -737,7 +737,7 @@ bool engage_contact_group(World& w, std::span<const std::uint32_t> members) {
       if (std::find(g.members.begin(), g.members.end(), d) == g.members.end() && w.supported(d)) release_support(w, d);
     }
     ++w.version[m];
-    g.acc.push_back(w.acc[m]);
+    g.acc.push_back(group_force_acc(w, m));
   }
   if (granular) {
     to_granular(g);
@@ -795,7 +795,7 @@ static void apply_absorb(World& w, Group& g, const std::vector<std::uint32_t>& a
       }
     }
     g.members.push_back(j);
-    g.acc.push_back(w.acc[j]);
+    g.acc.push_back(group_force_acc(w, j));
     g.fresh = true;
   }
 }
@@ -859,7 +859,7 @@ static void check_reach(World& w, const Box& swept, const StepContext& ctx, doub
     if (!w.alive(j)) continue;
     const Vec2 p0 = w.group_p0[j], p1 = w.pos[j];
     const Vec2 p2 = p0 + ctx.dt * w.group_v0[j];
-    const double r = w.radius[j] + (w.acc.empty() ? 0.0 : length(w.acc[j])) * ctx.dt * ctx.dt + tol;
+    const double r = w.radius[j] + (w.acc.empty() ? 0.0 : length(group_force_acc(w, j))) * ctx.dt * ctx.dt + tol;
     const Box bj{std::min({p0.x, p1.x, p2.x}) - r, std::min({p0.y, p1.y, p2.y}) - r,
                  std::max({p0.x, p1.x, p2.x}) + r, std::max({p0.y, p1.y, p2.y}) + r};
     bool hit = bj.overlaps(swept);
@@ -917,6 +917,7 @@ static void step_group(World& w, Group& g, const StepContext& ctx, std::vector<G
   for (const Vec2& q : s.v) vmax = std::max(vmax, length(q));
   double pad = vmax * ctx.dt + 4.0 * c.ascale * ctx.dt * ctx.dt + 1e-9 * c.scale;
   Box swept;
+  std::vector<double> mboxes;   // each member's swept box (x0, y0, x1, y1)
   std::vector<GEvent> evs;
   for (int attempt = 0; attempt < 8; ++attempt) {
     s = s_start;
@@ -931,6 +932,14 @@ static void step_group(World& w, Group& g, const StepContext& ctx, std::vector<G
       g.fresh = false;
     }
     swept = box_of(w, g.members, s, 0.0);
+    mboxes.assign(4 * g.members.size(), 0.0);
+    for (std::size_t q = 0; q < g.members.size(); ++q) {
+      const double r = w.radius[g.members[q]];
+      mboxes[4 * q] = s.x[q].x - r;
+      mboxes[4 * q + 1] = s.x[q].y - r;
+      mboxes[4 * q + 2] = s.x[q].x + r;
+      mboxes[4 * q + 3] = s.x[q].y + r;
+    }
     const double h0 = ctx.dt / kSubsteps;
     double t = 0.0;
     int events = 0;
@@ -968,6 +977,13 @@ static void step_group(World& w, Group& g, const StepContext& ctx, std::vector<G
         double vm = 0.0;
         for (const Vec2& q : e.v) vm = std::max(vm, length(q));
         swept.add(box_of(w, g.members, e, vm * tau));
+        for (std::size_t q = 0; q < g.members.size(); ++q) {   // each member's own box too
+          const double r = w.radius[g.members[q]] + vm * tau;
+          mboxes[4 * q] = std::min(mboxes[4 * q], e.x[q].x - r);
+          mboxes[4 * q + 1] = std::min(mboxes[4 * q + 1], e.x[q].y - r);
+          mboxes[4 * q + 2] = std::max(mboxes[4 * q + 2], e.x[q].x + r);
+          mboxes[4 * q + 3] = std::max(mboxes[4 * q + 3], e.x[q].y + r);
+        }
         project(c, e);
         s = e;
         t = tau >= h ? t_end : t + tau;
@@ -1007,7 +1023,7 @@ static void step_group(World& w, Group& g, const StepContext& ctx, std::vector<G
     w.group_why = "the exact group mode could not take its step (impacts that cycle, or an impulse on a sliding "
                   "contact with friction)";
   }
-  check_reach(w, swept, ctx, c.scale);
+  check_reach(w, swept, ctx, c.scale, &mboxes);
   swept_out = swept;
   // The mode failed in this step (a broken guarantee is reported): the group's step is undone
   // (its members at their state at the step's start, which overlaps nothing) and the engine
@@ -1031,7 +1047,7 @@ static void step_group(World& w, Group& g, const StepContext& ctx, std::vector<G
     w.pos[m] = s.x[q];
     w.vel[m] = s.v[q];
     w.tloc[m] = 0.0;
-    w.apath[m] = w.acc[m];
+    w.apath[m] = group_force_acc(w, m);
     ++w.version[m];
   }
   // Split: members touching (transitively) stay a group; a member touching none leaves it.
@@ -1152,12 +1168,13 @@ void advance_contact_groups(World& w, const StepContext& ctx) {
         w.pos[m] = w.group_p0[m];
         w.vel[m] = w.group_v0[m];
         w.tloc[m] = 0.0;
-        w.apath[m] = w.acc[m];
+        w.apath[m] = group_force_acc(w, m);
         ++w.version[m];
         merged.members.push_back(m);
-        merged.acc.push_back(w.acc[m]);
+        merged.acc.push_back(group_force_acc(w, m));
       }
     }
+    set_alive(w, merged, false);   // (a member its first step let go is hidden again)
     run(merged);
   }
   if (!drop_event.empty()) {

@@ -31,8 +31,6 @@
 #include <cstdint>
 #include <numeric>
 #include <vector>
-#include <cstdio>
-#include <cstdlib>
 
 #include "world.hpp"
 
@@ -40,7 +38,7 @@ namespace physval::core_detail {
 
 namespace {
 
-static int kSubsteps = getenv("GSUB") ? atoi(getenv("GSUB")) : 4;
+constexpr int kSubsteps = 4;
 constexpr int kMaxSweeps = 4000;
 constexpr double kEps = 2.220446049250313e-16;
 
@@ -228,8 +226,7 @@ void find_contacts(const World& w, const Group& g, Scratch& s, double h, double 
     }
     c.level = dot(point, up);
   }
-  static const bool down = getenv("GDOWN") != nullptr;
-  std::sort(out.begin(), out.end(), [](const Con& l, const Con& r) { return down ? l.level > r.level : l.level < r.level; });
+  std::sort(out.begin(), out.end(), [](const Con& l, const Con& r) { return l.level < r.level; });
 }
 
 void apply(Scratch& s, const Con& c, Vec2 P) {
@@ -383,7 +380,6 @@ void apply_ordered(Scratch& s, std::vector<Con>& cons, F f) {
 double pgs(Scratch& s, double tol, int& sweeps, bool& stagnated) {
   stagnated = false;
   const std::size_t n = s.cons.size();
-  static const bool plain = getenv("GPLAIN") != nullptr;
   thread_local std::vector<double> old, dir, step, terms;
   old.resize(2 * n);
   dir.assign(2 * n, 0.0);
@@ -404,10 +400,7 @@ double pgs(Scratch& s, double tol, int& sweeps, bool& stagnated) {
       old[2 * k + 1] = s.cons[k].pt;
     }
     change = sweep(s);
-    if (change <= tol || plain) {
-      if (change <= tol) break;
-      continue;
-    }
+    if (change <= tol) break;
     // |change|^2, summed in the sweep's order and within a block in the order of the terms'
     // values (no numbering changes a bit)
     double rn = 0.0;
@@ -498,12 +491,6 @@ void find_fixed(const World& w, const Group& g, const Scratch& s, double dt, std
 // One sub-step of length h. t_abs: the sub-step's start (absolute time).
 void substep(World& w, Group& g, Scratch& s, double h, double dt, double t_abs) {
   const std::size_t M = g.members.size();
-  const auto total_energy = [&]() {
-    double E = 0.0;
-    for (std::size_t q = 0; q < M; ++q) if (s.inv[q] > 0.0) E += (0.5 * length_squared(s.v[q]) - dot(s.a[q], s.x[q])) / s.inv[q];
-    return E;
-  };
-  const double E_debug0 = getenv("GENERGY") ? total_energy() : 0.0;
   const double skin = 1e-9 * w.length_scale;
   find_contacts(w, g, s, h, skin, s.cons);
   // warm start, scaled to this sub-step
@@ -543,8 +530,7 @@ void substep(World& w, Group& g, Scratch& s, double h, double dt, double t_abs) 
   for (std::size_t q = 0; q < M; ++q) s.v[q] += h * s.a[q];
   const double E_free = kinetic(s);
   apply_ordered(s, s.cons, [](const Con& c) { return c.pn * c.n + c.pt * perp(c.n); });
-  static const double rtol = getenv("GTOL") ? atof(getenv("GTOL")) : 1e-10;
-  const double tol = rtol * (vmax + amax * h) + 1e-300;
+  const double tol = 1e-10 * (vmax + amax * h) + 1e-300;
   int sweeps = 0;
   bool stagnated = false;
   double left = pgs(s, tol, sweeps, stagnated);
@@ -559,7 +545,6 @@ void substep(World& w, Group& g, Scratch& s, double h, double dt, double t_abs) 
     }
     left = pgs(s, tol, sweeps, stagnated);
   }
-  if (getenv("GSWEEPS")) fprintf(stderr, "SWEEPS %d cons %zu left %.3e bounces %ld\n", sweeps, s.cons.size(), left, std::count_if(s.cons.begin(), s.cons.end(), [](const Con& c) { return c.bounce; }));
   if (left > tol) {
     ++w.granular_unconverged;
     w.granular_worst_residual = std::max(w.granular_worst_residual, left);
@@ -588,14 +573,14 @@ void substep(World& w, Group& g, Scratch& s, double h, double dt, double t_abs) 
   // field's potential) may never rise in a sub-step with bounces; if it would, the sub-step's
   // bounces are perfectly inelastic.
   if (std::any_of(s.cons.begin(), s.cons.end(), [](const Con& c) { return c.bounce; })) {
-    const auto energy = [&](const std::vector<Vec2>& x, const std::vector<Vec2>& v, double& scale) {
+    const auto energy = [&](const std::vector<Vec2>& x, const std::vector<Vec2>& v, double& mag) {
       double E = 0.0;
-      scale = 0.0;
+      mag = 0.0;
       for (std::size_t q = 0; q < M; ++q) {
         if (!(s.inv[q] > 0.0)) continue;
         const double ke = 0.5 * length_squared(v[q]) / s.inv[q], pe = -dot(s.a[q], x[q]) / s.inv[q];
         E += ke + pe;
-        scale += ke + std::fabs(pe);
+        mag += ke + std::fabs(pe);
       }
       return E;
     };
@@ -611,7 +596,6 @@ void substep(World& w, Group& g, Scratch& s, double h, double dt, double t_abs) 
       move();
     }
   }
-  double E_debug1 = getenv("GENERGY") ? total_energy() : 0.0;
   // overlaps left by the turning normals (or a contact an impulse sped up): projected off,
   // nonlinear Gauss-Seidel on positions over every touching pair found anew
   const double ptol = 1e-12 * w.length_scale;
@@ -646,24 +630,6 @@ void substep(World& w, Group& g, Scratch& s, double h, double dt, double t_abs) 
       if (worst <= ptol) break;
     }
     if (!moved) break;   // nothing moved in this round: no new pair can overlap
-  }
-  if (getenv("GDEBUG")) {
-    for (std::size_t p = 0; p < M; ++p) for (std::size_t q = p + 1; q < M; ++q) {
-      const double o = s.rad[p] + s.rad[q] - length(s.x[p] - s.x[q]);
-      if (o > 1e-9) {
-        bool inproj = false;
-        for (const Con& c : s.proj) inproj = inproj || (c.a == (int)p && c.b == (int)q);
-        fprintf(stderr, "t=%.4f substep end: members %zu %zu (bodies %u %u) overlap %.3e in proj %d nproj %zu\n", t_abs, p, q, g.members[p], g.members[q], o, (int)inproj, s.proj.size());
-      }
-    }
-  }
-  if (getenv("GENERGY")) {
-    const double E2 = total_energy();
-    if (E2 > E_debug0 + 1e-6) {
-      int nb = 0; for (const Con& c : s.cons) nb += c.bounce;
-      fprintf(stderr, "t=%.4f E rise %.3e (before projection %.3e) bounces %d stag %d sweeps %d left %.3e KE free %.6e KE+ %.6e\n", t_abs, E2 - E_debug0, E_debug1 - E_debug0, nb, (int)stagnated, sweeps, left, E_free, kinetic(s));
-      for (const Con& c : s.cons) if (c.pn > 0) fprintf(stderr, "   con a=%d b=%d seg=%d gap=%.3e bias=%.3e bounce=%d pn=%.3e pt=%.3e e=%.2f\n", c.a, c.b, (int)c.seg, c.gap, c.bias, (int)c.bounce, c.pn, c.pt, c.e);
-    }
   }
   // contact events: a contact that takes an impulse begins unless the pair touched within dt
   for (const Con& c : s.cons) {
@@ -736,11 +702,6 @@ bool holds_at_rest(World& w, Group& g, Scratch& s, double h, double dt) {
   pgs(s, 1e-13 * amax * h + 1e-300, sweeps, stagnated);
   bool held = true;
   for (std::size_t q = 0; q < M && held; ++q) held = length(s.v[q]) <= 1e-10 * amax * h;
-  if (getenv("GREST")) {
-    double vm = 0.0;
-    for (std::size_t q = 0; q < M; ++q) vm = std::max(vm, length(s.v[q]));
-    fprintf(stderr, "   holds_at_rest: sweeps %d stag %d vmax %.3e (need %.3e) held %d\n", sweeps, (int)stagnated, vm, 1e-10 * amax * h, (int)held);
-  }
   (void)dt;
   s.v = v_keep;
   return held;
@@ -759,11 +720,6 @@ void granular_step(World& w, Group& g, const StepContext& ctx, std::vector<doubl
     s.boxes[4 * q + 2] = s.x[q].x + s.rad[q];
     s.boxes[4 * q + 3] = s.x[q].y + s.rad[q];
   }
-  if (getenv("GDEBUG")) {
-    fprintf(stderr, "t0=%.4f granular group of %zu:", ctx.t0, M);
-    for (std::uint32_t m : g.members) fprintf(stderr, " %u", m);
-    fprintf(stderr, "\n");
-  }
   if (g.fresh) g.sleeping = false;
   g.fresh = false;
   if (w.granular_first_time < 0.0) w.granular_first_time = ctx.t0;
@@ -778,11 +734,6 @@ void granular_step(World& w, Group& g, const StepContext& ctx, std::vector<doubl
     bool slow = true;
     for (std::size_t q = 0; q < M; ++q) amax = std::max(amax, length(s.a[q]));
     for (std::size_t q = 0; q < M && slow; ++q) slow = length(s.v[q]) <= w.rest_speed(amax, ctx.dt);
-    if (getenv("GREST")) {
-      double vm = 0.0;
-      for (std::size_t q = 0; q < M; ++q) vm = std::max(vm, length(s.v[q]));
-      fprintf(stderr, "t=%.3f M=%zu vmax %.3e slow %d\n", ctx.t0, M, vm, (int)slow);
-    }
     if (slow && amax > 0.0 && holds_at_rest(w, g, s, h, ctx.dt)) {
       g.sleeping = true;
       std::fill(s.v.begin(), s.v.end(), Vec2{});
@@ -794,7 +745,7 @@ void granular_step(World& w, Group& g, const StepContext& ctx, std::vector<doubl
     w.pos[m] = s.x[q];
     w.vel[m] = s.v[q];
     w.tloc[m] = 0.0;
-    w.apath[m] = w.acc[m];
+    w.apath[m] = group_force_acc(w, m);
     ++w.version[m];
   }
   // contacts touching at the step's end continue (no new contact event later)
@@ -931,7 +882,7 @@ void engage_storm_groups(World& w, const StepContext& ctx) {
       }
       ++w.version[m];
       g.members.push_back(m);
-      g.acc.push_back(w.acc[m]);
+      g.acc.push_back(group_force_acc(w, m));
     }
     if (w.group_first_time < 0.0) w.group_first_time = w.time;
     w.contact_groups.push_back(std::move(g));

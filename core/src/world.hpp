@@ -747,6 +747,11 @@ void kill_body(World& w, std::uint32_t i);
 bool engage_contact_group(World& w, std::span<const std::uint32_t> members);
 void hide_contact_groups(World& w, const StepContext& ctx);
 void advance_contact_groups(World& w, const StepContext& ctx);
+// A body's force acceleration where contact groups are allowed (constant forces): w.acc is 0
+// for a body hidden in a group when the step's forces were computed, so groups take it here.
+inline Vec2 group_force_acc(const World& w, std::uint32_t i) {
+  return w.dynamic(i) || (w.flags[i] & (kAlive | kStatic)) == 0 ? body_acceleration(w, i, w.vel[i]) : Vec2{};
+}
 // Whether the scene allows contact groups at all (exact impacts, constant forces, no rules,
 // emitters or Newtonian gravity).
 bool contact_groups_allowed(const World& w);

@@ -233,26 +233,34 @@ TEST(CorePile, HeavyBodyDroppedOnLightStackSettles) {
   EXPECT_EQ(sim.state("heavy").velocity, Vec2{});
 }
 
-// Piles: n circles (make_circle_pile) dropped into a closed box, friction 0.5, 30 s.
+// Piles: n circles (make_circle_pile) dropped into a closed box, 30 s. Each one collapses
+// (issue 9's inelastic collapse) and settles. Since branch granular13 the dense phase of every
+// pile is moved by core's granular groups (nonsmooth contact dynamics, granular.cpp): before,
+// 8 of these 10 friction piles held a leaning group rigid Coulomb cannot hold (a broken
+// guarantee: diverged), 6 of 7 frictionless ones a wedged one, and frictionless piles of 50
+// and more did not settle in minutes. Now every one must settle within core's model: no broken
+// guarantee, no event cap, no overlap deeper than 1e-9 m (sampled every 30 steps and at the
+// end), energy never rising (but the engine's micro-bounce, bounded below), every body at rest
+// at the end with no events, and nothing in limits_hit but the granular mode's own statement
+// (first order, not exact) or the exact group mode's.
 struct PileCase {
   int n;
   double e;
   std::uint64_t seed;
   double mu = 0.5;
-  // Why core is expected to hold something there that rigid Coulomb cannot (README, The hunt
-  // for wrong greens); nullptr: it must settle within its model.
-  const char* beyond = nullptr;
 };
 
 class CorePileSettles : public ::testing::TestWithParam<PileCase> {};
 
+bool only_group_notes(const std::vector<std::string>& limits) {
+  for (const std::string& l : limits) {
+    if (l.rfind("granular contact", 0) != 0 && l.rfind("bodies moving in contact", 0) != 0) return false;
+  }
+  return true;
+}
+
 TEST_P(CorePileSettles, SettlesWithoutOverlapCapOrEnergyGain) {
   const PileCase c = GetParam();
-#if defined(__SANITIZE_ADDRESS__)
-  // The 100- and 200-circle piles take 30 s and 2.5 min in Release; a sanitized Debug build
-  // is 10-20x slower. The sanitizers check the same code on the 10- and 50-circle piles.
-  if (c.n > 50) GTEST_SKIP() << "pile of " << c.n << ": Release build only (too slow under the sanitizers)";
-#endif
   Sim sim(make_circle_pile(c.n, c.e, c.mu, c.seed));
   // Energy never rises, but for the micro-bounce of a pressed pair that nothing can hold
   // (it leaves at half the rest speed v_r = g dt / 16): at most m (v_r / 2)^2 / 2 per body
@@ -264,26 +272,11 @@ TEST_P(CorePileSettles, SettlesWithoutOverlapCapOrEnergyGain) {
   double E_prev = INFINITY;
   double worst_rise = 0.0;
   std::int64_t last_events = -1;
-  std::string beyond;
-  // 30 s: most piles are at rest within 1 s; the slowest here (100 circles at e = 0.6)
-  // keeps a few bodies micro-bouncing until about 29 s (README, Known limits).
   const int steps = 1800;
   for (int k = 0; k < steps; ++k) {
     sim.step(dt);
     ASSERT_FALSE(sim.engine.last_step_stats().event_cap_hit) << "step " << k;
-    // A hold core cannot justify (its resting component, judged by rigid Coulomb, must move)
-    // is reported, not hidden: the pile is then beyond core's model and its run is diverged,
-    // which is what a user sees. Only where the case says so (PileCase::beyond, with the
-    // reason), and only with rigid Coulomb's certificate ("cannot hold it", not "could not
-    // show"); everything else below is asserted all the same (core's path is not the
-    // physics then, but it must still never overlap, gain energy or hit the event cap).
-    if (const std::string b = sim.engine.broken_guarantee(); !b.empty() && beyond.empty()) {
-      // (or, since contact12, the contact-group mode that moves such a component reporting
-      // what it does not model there)
-      ASSERT_TRUE(b.find("cannot hold it") != std::string::npos || b.find("bodies moving in contact") != std::string::npos)
-          << "step " << k << ": " << b;
-      beyond = b;
-    }
+    ASSERT_EQ(sim.engine.broken_guarantee(), "") << "step " << k;
     sim.engine.read_states(sim.states);
     const double E = energy(sim.states, sim.scene);
     if (k > 0) worst_rise = std::max(worst_rise, E - E_prev);
@@ -298,70 +291,27 @@ TEST_P(CorePileSettles, SettlesWithoutOverlapCapOrEnergyGain) {
   EXPECT_LE(deepest_overlap(sim.states, sim.scene), 1e-9);
   EXPECT_EQ(last_events, 0);   // settled: nothing happens any more
   for (const BodyState& s : sim.states) EXPECT_EQ(s.velocity, Vec2{});
-  EXPECT_TRUE(sim.engine.limits_hit().empty());
+  EXPECT_TRUE(only_group_notes(sim.engine.limits_hit()));
   RecordProperty("worst_energy_rise_J", std::to_string(worst_rise));
-  if (c.beyond == nullptr) {
-    EXPECT_EQ(beyond, "") << "a hold core cannot justify in a pile expected to settle within its model";
-  } else {
-    RecordProperty("beyond_core_model", beyond);
-    if (beyond.empty()) std::cout << "note: no longer reported beyond core's model (" << c.beyond << ")\n";
-  }
 }
 
-// Every pile but two holds, while it settles, a group its resting component cannot hold by
-// rigid Coulomb (judge_braced_holds; each checked by an independent linear program, HiGHS:
-// no forces within the friction cones balance the weights, the least relative residual 0.9% to
-// 30% of them): the run is diverged from then on. The body, time, component size and the
-// acceleration left on a member (the first report, at main 373ff33 + this check):
-constexpr const char* kLeaning = "a leaning group core holds as if its supports were fixed";
 INSTANTIATE_TEST_SUITE_P(Piles, CorePileSettles,
-                         ::testing::Values(PileCase{10, 0.3, 1}, PileCase{10, 0.0, 2},
-                                           // p2 at 1.02 s: p3 wedged between the right wall and p2,
-                                           // which slides out (2 bodies, 0.36 m/s^2)
-                                           PileCase{10, 0.9, 3, 0.5, kLeaning},
-                                           // p0 at 0.5 s: a leaning tower p3-p10-p17-p24-p31 (42, 0.15)
-                                           PileCase{50, 0.3, 1, 0.5, kLeaning},
-                                           PileCase{50, 0.0, 2, 0.5, kLeaning},   // p0 at 0.48 s (22, 0.59)
-                                           PileCase{50, 0.9, 3, 0.5, kLeaning},   // p0 at 0.68 s (45, 1.29)
-                                           PileCase{50, 0.5, 4, 0.5, kLeaning},   // p2 at 0.32 s (14, 1.04)
-                                           PileCase{100, 0.3, 5, 0.5, kLeaning},  // p0 at 0.45 s (16, 3.9)
-                                           PileCase{100, 0.6, 6, 0.5, kLeaning},  // p1 at 0.43 s (31, 5.7)
-                                           PileCase{200, 0.3, 7, 0.5, kLeaning}), // p6 at 0.3 s (20, 1.96)
+                         ::testing::Values(PileCase{10, 0.3, 1}, PileCase{10, 0.0, 2}, PileCase{10, 0.9, 3},
+                                           PileCase{50, 0.3, 1}, PileCase{50, 0.0, 2}, PileCase{50, 0.9, 3},
+                                           PileCase{50, 0.5, 4}, PileCase{100, 0.3, 5}, PileCase{100, 0.6, 6},
+                                           PileCase{200, 0.3, 7}),
                          [](const auto& test_info) {
                            return "n" + std::to_string(test_info.param.n) + "_e" +
                                   std::to_string(static_cast<int>(test_info.param.e * 10)) + "_seed" +
                                   std::to_string(test_info.param.seed);
                          });
 
-// Frictionless piles (mu = 0): held only where the normals alone balance each body's
-// weight (a pocket, a jammed group), which the collapse approaches through ever shorter
-// hops; they reached the event cap until a body falling into a slot between two held
-// ones, and two circles sliding side by side, stopped being read as impacts at one
-// instant for ever (exact_collisions.cpp). Same assertions as with friction.
-// All six hold a body wedged on bodies that a frictionless floor lets slide (reported as
-// above): p3 at 0.52 s between the right wall and p3's floor ball, 2.6e-7 m from its neighbour
-// and 0.028 m of free row behind (2 bodies, 7.2 m/s^2); p0 at 0.75 s, p8 on p0 leaning 3.2e-8
-// rad, p0 pushed off the wall at 3.2e-7 m/s^2 (2 bodies; rigid Coulomb at 1e-9, the group
-// test's tolerance); p1 at 0.88 s (5, 9.8: a ball wedged 3e-4 m above the floor between two
-// that can spread 5e-7 m); p1 at 1.95 s (4, 9.8); p0 at 0.48 s (9, 4.0: p6 on p2 and p7, p2
-// free to slide left); p2 at 0.8 s (3, 2.19). With frictionless sliders in simultaneous sets
-// and group holds (branch numbering2) the paths differ: e 0, 0.9 and seeds 2, 3 are still
-// reported (p0 at 0.92 s, 10 bodies; p2 at 2.18 s, 2: p3 held 9.3e-5 m above the floor
-// against a frictionless wall, touching p2 4.7e-4 rad off the horizontal; p4 at 0.88 s, 10:
-// a row held on contacts 1e-7 rad off the horizontal, forces 2e6 g; p3 at 1.07 s, 5; the
-// e 0.9 and seed 2 components checked by scipy, HiGHS infeasible and NNLS leaving a held body
-// accelerating), e 0.3 and 0.6 of seed 1 settle unreported.
-constexpr const char* kWedged = "a ball wedged on balls a frictionless floor lets slide";
-constexpr const char* kFrictionlessGroup = "a frictionless group core holds (reported, cause not analysed)";
+// Frictionless piles (mu = 0): held only where the normals alone balance each body's weight
+// (a pocket, a jammed group), which the collapse approaches through ever shorter hops.
 INSTANTIATE_TEST_SUITE_P(FrictionlessPiles, CorePileSettles,
-                         ::testing::Values(PileCase{10, 0.0, 1, 0.0, kWedged}, PileCase{10, 0.3, 1, 0.0, kWedged},
-                                           PileCase{10, 0.6, 1, 0.0, kWedged}, PileCase{10, 0.9, 1, 0.0, kWedged},
-                                           PileCase{10, 0.3, 2, 0.0, kWedged}, PileCase{10, 0.3, 3, 0.0, kWedged},
-                                           // 50 circles at e 0.9, seed 3: sets of nearly collinear
-                                           // contacts Gauss-Seidel could not solve (branch pgsfix:
-                                           // solved exactly by non-negative least squares); p0 at
-                                           // 1.35 s (24 bodies, 9.8 m/s^2; not analysed further)
-                                           PileCase{50, 0.9, 3, 0.0, kFrictionlessGroup}),
+                         ::testing::Values(PileCase{10, 0.0, 1, 0.0}, PileCase{10, 0.3, 1, 0.0}, PileCase{10, 0.6, 1, 0.0},
+                                           PileCase{10, 0.9, 1, 0.0}, PileCase{10, 0.3, 2, 0.0}, PileCase{10, 0.3, 3, 0.0},
+                                           PileCase{50, 0.9, 3, 0.0}, PileCase{50, 0.3, 1, 0.0}),
                          [](const auto& test_info) {
                            return "n" + std::to_string(test_info.param.n) + "_e" +
                                   std::to_string(static_cast<int>(test_info.param.e * 10)) + "_seed" +
