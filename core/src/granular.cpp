@@ -39,7 +39,7 @@ namespace physval::core_detail {
 namespace {
 
 constexpr int kSubsteps = 4;
-constexpr int kMaxSweeps = 4000;
+constexpr int kMaxSweeps = 1000;
 constexpr double kEps = 2.220446049250313e-16;
 
 using Group = World::ContactGroup;
@@ -71,6 +71,7 @@ struct Scratch {
   std::vector<char> touched;
   std::vector<std::uint64_t> recorded;
   std::vector<double> boxes;   // per member: the box it swept in the step (x0, y0, x1, y1)
+  bool smooth_face = false;    // a face with interpolated normals (a surface) came near
 };
 
 void pair_geo(Vec2 xa, double ra, Vec2 xb, double rb, Vec2& n, double& gap) {
@@ -187,6 +188,8 @@ void find_contacts(const World& w, const Group& g, Scratch& s, double h, double 
     s.segs.clear();
     w.statics.query(make_aabb(s.x[q].x - pad, s.x[q].y - pad, s.x[q].x + pad, s.x[q].y + pad), s.segs);
     for (std::uint32_t k : s.segs) {
+      const Segment& sg = w.statics.segments[k];
+      if (length_squared(sg.normal_from) > 0.0 || length_squared(sg.normal_to) > 0.0) s.smooth_face = true;
       Con c;
       c.b = static_cast<std::int32_t>(q);
       c.seg = true;
@@ -600,6 +603,7 @@ void substep(World& w, Group& g, Scratch& s, double h, double dt, double t_abs) 
   // nonlinear Gauss-Seidel on positions over every touching pair found anew
   const double ptol = 1e-12 * w.length_scale;
   thread_local std::vector<Kick> kicks;
+  thread_local std::vector<std::int32_t> pdeg;
   for (int round = 0; round < 8; ++round) {
     find_contacts(w, g, s, 0.0, ptol, s.proj);
     bool moved = false;
@@ -610,13 +614,21 @@ void substep(World& w, Group& g, Scratch& s, double h, double dt, double t_abs) 
         std::size_t j = i + 1;
         while (j < np && s.proj[j].level == s.proj[i].level) ++j;
         kicks.clear();
+        int most = 1;   // relaxed by the most block contacts one body has
+        if (j > i + 1) {
+          pdeg.assign(M, 0);
+          for (std::size_t q = i; q < j; ++q) {
+            most = std::max(most, ++pdeg[static_cast<std::size_t>(s.proj[q].b)]);
+            if (s.proj[q].a >= 0) most = std::max(most, ++pdeg[static_cast<std::size_t>(s.proj[q].a)]);
+          }
+        }
         for (std::size_t q = i; q < j; ++q) {
           Con& c = s.proj[q];
           con_geo(w, s, c, s.x);
           if (c.gap >= -ptol) continue;
           worst = std::max(worst, -c.gap);
           moved = true;
-          const double d = -c.gap / c.k / static_cast<double>(j - i);
+          const double d = -c.gap / c.k / static_cast<double>(most);
           kicks.push_back({c.b, (d * s.inv[static_cast<std::size_t>(c.b)]) * c.n});
           if (c.a >= 0) kicks.push_back({c.a, (-d * s.inv[static_cast<std::size_t>(c.a)]) * c.n});
           if (j == i + 1) {
@@ -725,10 +737,16 @@ void granular_step(World& w, Group& g, const StepContext& ctx, std::vector<doubl
   if (w.granular_first_time < 0.0) w.granular_first_time = ctx.t0;
   ++w.granular_steps;
   if (!g.sleeping) {
+    s.smooth_face = false;
     find_fixed(w, g, s, ctx.dt, s.fixed);
     s.recorded.clear();
     const double h = ctx.dt / kSubsteps;
     for (int k = 0; k < kSubsteps; ++k) substep(w, g, s, h, ctx.dt, ctx.t0 + k * h);
+    if (s.smooth_face && w.group_disturbed == kNone) {   // contacts there take the faces' own normals
+      w.group_disturbed = g.members.front();
+      w.group_disturbed_time = ctx.t0;
+      w.group_why = "a face near it has interpolated normals (a surface), which the granular mode does not model";
+    }
     // asleep: every body slower than the rest speed, and the contacts hold the group at rest
     double amax = 0.0;
     bool slow = true;
@@ -861,14 +879,34 @@ void engage_storm_groups(World& w, const StepContext& ctx) {
     members.insert(members.end(), add.begin(), add.end());
     // groups it reaches: their members join this one
     std::sort(merge.begin(), merge.end());
-    for (std::size_t k = merge.size(); k-- > 0;) {
-      Group& o = w.contact_groups[merge[k]];
+    merge.erase(std::unique(merge.begin(), merge.end()), merge.end());
+    for (std::size_t k : merge) {
+      const Group& o = w.contact_groups[k];
       members.insert(members.end(), o.members.begin(), o.members.end());
-      w.contact_groups.erase(w.contact_groups.begin() + static_cast<std::ptrdiff_t>(merge[k]));
     }
     std::sort(members.begin(), members.end());
     members.erase(std::unique(members.begin(), members.end()), members.end());
     if (members.size() < 2) continue;
+    // a surface (faces with interpolated normals) within reach: the granular mode does not
+    // model it; the event-driven engine keeps the storm
+    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+    for (std::uint32_t m : members) {
+      const double r = w.radius[m] + 2.0 * (length(w.vel[m]) * ctx.dt + length(group_force_acc(w, m)) * ctx.dt * ctx.dt);
+      x0 = std::min(x0, w.pos[m].x - r);
+      y0 = std::min(y0, w.pos[m].y - r);
+      x1 = std::max(x1, w.pos[m].x + r);
+      y1 = std::max(y1, w.pos[m].y + r);
+    }
+    w.found_static.clear();
+    w.statics.query(make_aabb(x0, y0, x1, y1), w.found_static);
+    const bool smooth = std::any_of(w.found_static.begin(), w.found_static.end(), [&](std::uint32_t k) {
+      const Segment& sg = w.statics.segments[k];
+      return length_squared(sg.normal_from) > 0.0 || length_squared(sg.normal_to) > 0.0;
+    });
+    if (smooth) continue;
+    for (std::size_t k = merge.size(); k-- > 0;) {
+      w.contact_groups.erase(w.contact_groups.begin() + static_cast<std::ptrdiff_t>(merge[k]));
+    }
     Group g;
     g.granular = true;
     g.fresh = true;

@@ -668,7 +668,7 @@ TEST(Hunt, CoreCollapsesTheFrictionlessPyramid) {
 TEST(Hunt, CoreSettlesPile50) {
   const EngineFactory* core = reference_engine();
   ASSERT_NE(core, nullptr);
-  const ScenarioLoad l = load_scenario_file(std::string(PHYSVAL_SOURCE_DIR) + "/validation/tests/hunt/pile_50.toml");
+  const ScenarioLoad l = load_scenario_file(std::string(PHYSVAL_SOURCE_DIR) + "/validation/scenarios/hard/pile_50.toml");
   ASSERT_TRUE(l.scene.has_value());
   const RunRecord r = run_and_compare(*l.scene, *core);
   EXPECT_EQ(r.status, RunStatus::Ok) << r.reason;
