@@ -474,6 +474,10 @@ class JsonStream {
     std::string& t = text_;
     t.clear();
     t += "[\n";
+    char time_text[64];
+    std::size_t time_text_size = 0;
+    double last_time = 0.0;
+    bool have_time = false;
     for (std::size_t k = 0; k < cs.size(); ++k) {
       const ContactRecord& c = cs[k];
       t += open;
@@ -487,8 +491,15 @@ class JsonStream {
       }
       t += to_time;
       if (std::isfinite(c.time)) {
-        char buf[64];
-        t.append(buf, nlohmann::detail::to_chars(buf, buf + sizeof buf, c.time));
+        // A run's contacts come in time order, many in one step at the same time (every
+        // contact a step-end engine reports in a step): the text of the time before is
+        // reused when the double is the same, bit for bit.
+        if (!(have_time && std::memcmp(&c.time, &last_time, sizeof last_time) == 0)) {
+          time_text_size = static_cast<std::size_t>(nlohmann::detail::to_chars(time_text, time_text + sizeof time_text, c.time) - time_text);
+          last_time = c.time;
+          have_time = true;
+        }
+        t.append(time_text, time_text_size);
       } else {
         t += "null";
       }
