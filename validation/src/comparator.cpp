@@ -133,41 +133,42 @@ template <class Key, class Hash>
 class FlatIds {
  public:
   FlatIds() { slots_.resize(64); }
-  std::size_t size() const { return count_; }
+  std::size_t size() const { return keys_.size(); }
   // The id of `key` (a new one when it was not there) and the key as the table holds it.
-  std::pair<std::uint32_t, const Key*> id(const Key& key) {
-    if (2 * (count_ + 1) > slots_.size()) grow();
-    const std::size_t mask = slots_.size() - 1;
-    for (std::size_t s = Hash{}(key) & mask;; s = (s + 1) & mask) {
+  std::pair<std::uint32_t, Key> id(const Key& key) {
+    if (2 * (keys_.size() + 1) > slots_.size()) grow();
+    const std::size_t h = Hash{}(key), mask = slots_.size() - 1;
+    const auto tag = static_cast<std::uint32_t>(h >> 32);
+    for (std::size_t s = h & mask;; s = (s + 1) & mask) {
       Slot& slot = slots_[s];
       if (slot.id == kEmpty) {
-        slot.key = key;
-        slot.id = static_cast<std::uint32_t>(count_++);
-        return {slot.id, &slot.key};
+        slot = {tag, static_cast<std::uint32_t>(keys_.size())};
+        keys_.push_back(key);
+        return {slot.id, key};
       }
-      if (slot.key == key) return {slot.id, &slot.key};
+      if (slot.tag == tag && keys_[slot.id] == key) return {slot.id, keys_[slot.id]};
     }
   }
 
  private:
   static constexpr std::uint32_t kEmpty = 0xffffffffu;
+  // 8 bytes a slot, at most half of them used; the keys themselves are kept once, in order.
   struct Slot {
-    Key key{};
+    std::uint32_t tag = 0;   // the hash's high bits: most other keys are told apart without a look
     std::uint32_t id = kEmpty;
   };
   void grow() {
-    std::vector<Slot> old(slots_.size() * 2);
-    old.swap(slots_);
+    slots_.assign(slots_.size() * 2, Slot{});
     const std::size_t mask = slots_.size() - 1;
-    for (const Slot& o : old) {
-      if (o.id == kEmpty) continue;
-      std::size_t s = Hash{}(o.key) & mask;
+    for (std::uint32_t id = 0; id < keys_.size(); ++id) {
+      const std::size_t h = Hash{}(keys_[id]);
+      std::size_t s = h & mask;
       while (slots_[s].id != kEmpty) s = (s + 1) & mask;
-      slots_[s] = o;
+      slots_[s] = {static_cast<std::uint32_t>(h >> 32), id};
     }
   }
   std::vector<Slot> slots_;
-  std::size_t count_ = 0;
+  std::vector<Key> keys_;
 };
 
 struct MixHash {   // a 64-bit value's bits spread over the low ones (the table's mask)
@@ -242,7 +243,7 @@ struct PairTable {
       const std::uint64_t key = (static_cast<std::uint64_t>(std::min(x, y)) << 32) | std::max(x, y);
       out[k] = pairs.id(key).first;
       if (use_recent) {
-        recent[recent_next] = {*xa.second, *yb.second, out[k]};
+        recent[recent_next] = {xa.second, yb.second, out[k]};
         recent_next = (recent_next + 1) % kRecent;
         recent_count = std::max(recent_count, recent_next == 0 ? kRecent : recent_next);
       }
