@@ -60,7 +60,7 @@ def main():
     for name, text, (y, vy), h in scenes():
         open(os.path.join(sdir, name + ".toml"), "w").write(text)
         truth[name] = (y, vy, h)
-    subprocess.run([physval, "run", sdir, "--engines", engines, "--out", os.path.join(out, "run"), "-j2", "--no-cache",
+    subprocess.run([physval, "run", sdir, "--engines", engines, "--out", os.path.join(out, "run"), "-j2", "--no-cache", "--series-csv",
                     "--quiet"], check=False)
     res = json.load(open(os.path.join(out, "run", "results.json")))
     okwrong = 0

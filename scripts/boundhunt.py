@@ -224,8 +224,15 @@ def pair_binding(toml_text):
     return best
 
 
+def series_csv_flag(physval):
+    # The series are read as CSV: `--series-csv` where the binary has it (a binary older than
+    # the .bin series files writes CSV anyway).
+    h = subprocess.run([physval, "run", "--help"], capture_output=True, text=True)
+    return ["--series-csv"] if "--series-csv" in h.stdout + h.stderr else []
+
+
 def run(physval, scene_dir, out):
-    r = subprocess.run([physval, "run", scene_dir, "--out", out, "-j2", "--no-cache", "--quiet"],
+    r = subprocess.run([physval, "run", scene_dir, "--out", out, "-j2", "--no-cache", "--quiet"] + series_csv_flag(physval),
                        capture_output=True, text=True)
     if r.returncode not in (0, 1):
         sys.exit(f"{physval} failed ({r.returncode}): {r.stdout[-2000:]} {r.stderr[-2000:]}")

@@ -880,7 +880,7 @@ def main():
                 fh.write(c.toml)
         out = os.path.join(work, fam, "out")
         if not judge_only:
-          subprocess.run([physval, "run", d, "--engines", "core", "--out", out, "-j", jobs, "--no-cache", "--quiet"],
+          subprocess.run([physval, "run", d, "--engines", "core", "--out", out, "-j", jobs, "--no-cache", "--quiet", "--series-csv"],
                        stdout=subprocess.DEVNULL)
         with open(os.path.join(out, "results.json")) as fh:
             res = json.load(fh)

@@ -886,7 +886,7 @@ for f in "$work"/refuse/*.toml; do
   fi
 done
 set +e
-"$physval" run "$work/scenes" --engines "$engines" --out "$work/out" -j "$jobs" --quiet --no-cache > "$work/run.txt" 2>&1
+"$physval" run "$work/scenes" --engines "$engines" --out "$work/out" -j "$jobs" --quiet --no-cache --series-csv > "$work/run.txt" 2>&1
 status=$?
 set -e
 if [ "$status" -ge 2 ]; then cat "$work/run.txt" >&2; echo "hunt: physval run exited $status" >&2; exit 2; fi

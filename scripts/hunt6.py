@@ -703,7 +703,7 @@ def main(argv):
         truth = {}
         FAMILIES[fam](scenes, truth, quick)
         res_dir = os.path.join(out, "out")
-        p = subprocess.run([physval, "run", scenes, "--out", res_dir, "-j", str(jobs), "--no-cache"],
+        p = subprocess.run([physval, "run", scenes, "--out", res_dir, "-j", str(jobs), "--no-cache", "--series-csv"],
                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
         if p.returncode not in (0, 1):
             print(f"{fam}: physval run exited {p.returncode}: {p.stderr[-400:]}", file=sys.stderr)

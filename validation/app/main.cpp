@@ -28,6 +28,7 @@
 #include "physval/validation/reference_cache.hpp"
 #include "physval/validation/scheduler.hpp"
 #include "physval/validation/merge.hpp"
+#include "physval/validation/series_file.hpp"
 #include "physval/validation/shard.hpp"
 #include "physval/validation/sweep.hpp"
 
@@ -78,6 +79,7 @@ struct CommonOptions {
   std::string shard;   // "I/N"
   double max_memory_mb = 0.0;
   std::vector<std::string> plugins;
+  bool series_csv = false;   // --series-csv
 };
 
 // --max-memory MB: the limit the memory estimate of each scene is held to (0: half of the
@@ -110,6 +112,9 @@ void add_common(CLI::App* cmd, CommonOptions& o) {
                   "seconds an engine run and the reference it is compared with may take together; the run is "
                   "stopped when they exceed it (0: no limit)");
   cmd->add_flag("--quiet", o.quiet, "print only the summary line");
+  cmd->add_flag("--series-csv", o.series_csv,
+                "write each run's time series as CSV text (series/<scenario>/<engine>.csv) instead of the "
+                "binary .bin files (`physval series-csv DIR` converts those later)");
   cmd->add_option("--cache", o.cache, "reference cache folder (default $XDG_CACHE_HOME/physval/references or ~/.cache/...)");
   cmd->add_flag("--no-cache", o.no_cache, "compute every reference, read and write no cache");
   cmd->add_option("--max-memory", o.max_memory_mb,
@@ -345,7 +350,7 @@ int run_or_gate(const CommonOptions& o, bool gate, const std::string& junit, con
   }
   try {
     // Everything goes into the staging folder, which then replaces --out whole.
-    write_results(out->staging(), result);
+    write_results(out->staging(), result, o.series_csv ? SeriesFormat::Csv : SeriesFormat::Binary);
     bool report_written = false;
     if (report) {
       try {
@@ -518,6 +523,11 @@ int main(int argc, char** argv) {
   auto* report = app.add_subcommand("report", "write report.html with plots for a results folder of `run` or `gate`");
   report->add_option("DIR", report_dir, "the folder holding results.json and series/")->required();
 
+  std::vector<std::string> series_csv_dirs;
+  auto* series_csv = app.add_subcommand(
+      "series-csv", "write series/<scenario>/<engine>.csv beside each .bin series file of results folders");
+  series_csv->add_option("DIR", series_csv_dirs, "output folders of `run`, `gate` or `merge`")->required();
+
   MergeOptions merge_opts;
   auto* merge = app.add_subcommand("merge", "join the output folders of `--shard I/N` runs (or sweeps) into one, as a single run writes it");
   merge->add_option("DIR", merge_opts.dirs, "every shard's output folder (each holds results.json or sweep.json)")->required();
@@ -564,6 +574,18 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*merge) return merge_shards(merge_opts, std::cout, std::cerr);
+    if (*series_csv) {
+      for (const std::string& d : series_csv_dirs) {
+        if (!std::filesystem::exists(std::filesystem::path(d) / "results.json")) {
+          return bad_input(d + ": no results.json here (not an output folder of `physval run`)");
+        }
+      }
+      for (const std::string& d : series_csv_dirs) {
+        const std::size_t n = convert_series_to_csv(d);
+        std::cout << d << ": " << n << " series file" << (n == 1 ? "" : "s") << " written as CSV\n";
+      }
+      return 0;
+    }
     if (*engines) {
       print_engines(engines_json);
       return 0;

@@ -12,6 +12,8 @@
 #include "physval/validation/comparator.hpp"
 #include "physval/validation/results_json.hpp"
 #include "physval/validation/runner.hpp"
+#include "physval/validation/scenario_loader.hpp"
+#include "physval/adapters/registry.hpp"
 #include "../src/containment.hpp"
 #include "../src/number_text.hpp"
 
@@ -200,6 +202,45 @@ void BM_ContainmentObserveGas(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n));
 }
 BENCHMARK(BM_ContainmentObserveGas)->Args({200, 220})->Args({1000, 220})->Args({200, 162})->Unit(benchmark::kMicrosecond);
+
+// Containment after every step of circle_gas as an engine ran it (`range(0)`: 0 core, 1
+// box2d): the states after each of its 300 steps are recorded once, then one iteration
+// observes them all with a fresh monitor (start and 300 observes). The gas of the
+// synthetic case above moves straight through itself; this one collides, packs and
+// bounces as the runs the harness checks do.
+void BM_ContainmentCircleGasRun(benchmark::State& state) {
+  const ScenarioLoad load = load_scenario_file(PHYSVAL_SOURCE_SCENARIOS "/models/circle_gas.toml");
+  if (!load.scene) {
+    state.SkipWithError("cannot load circle_gas.toml");
+    return;
+  }
+  const Scene& scene = *load.scene;
+  const char* wanted = state.range(0) == 0 ? "core" : "box2d";
+  const EngineFactory* factory = nullptr;
+  for (const EngineFactory& f : engine_registry()) {
+    if (f.info.name == wanted) factory = &f;
+  }
+  if (factory == nullptr) {
+    state.SkipWithError("engine not built");
+    return;
+  }
+  std::unique_ptr<Engine> engine = factory->create();
+  engine->load(scene);
+  std::vector<std::vector<BodyState>> after(static_cast<std::size_t>(scene.steps()) + 1);
+  engine->read_states(after[0]);
+  for (std::size_t k = 1; k < after.size(); ++k) {
+    engine->step(scene.dt);
+    engine->read_states(after[k]);
+  }
+  for (auto _ : state) {
+    ContainmentMonitor monitor(scene);
+    monitor.start(after[0]);
+    for (std::size_t k = 1; k < after.size(); ++k) monitor.observe(scene.dt * static_cast<double>(k), after[k]);
+    benchmark::DoNotOptimize(monitor.record());
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(after.size() - 1));
+}
+BENCHMARK(BM_ContainmentCircleGasRun)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // Containment after one step of orbit_1000_periods (two points, no barriers: 2M calls in
 // the built-in suite, a fixed cost of every step of every small scene).

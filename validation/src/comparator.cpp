@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -124,15 +125,81 @@ struct ContactMatch {
   std::vector<std::optional<double>> per_reference;   // error of each reference contact (nullopt: missed)
 };
 
+// Dense ids of keys in the order they are first met (id = how many were there before),
+// in a flat table with open addressing (linear probing, a power-of-two size at most half
+// full): a gas's contact lists look up two names and a pair per contact, and the node-based
+// std::unordered_map with its prime-modulo buckets was most of that time.
+template <class Key, class Hash>
+class FlatIds {
+ public:
+  FlatIds() { slots_.resize(64); }
+  std::size_t size() const { return keys_.size(); }
+  // The id of `key` (a new one when it was not there) and the key as the table holds it.
+  std::pair<std::uint32_t, Key> id(const Key& key) {
+    if (2 * (keys_.size() + 1) > slots_.size()) grow();
+    const std::size_t h = Hash{}(key), mask = slots_.size() - 1;
+    const auto tag = static_cast<std::uint32_t>(h >> 32);
+    for (std::size_t s = h & mask;; s = (s + 1) & mask) {
+      Slot& slot = slots_[s];
+      if (slot.id == kEmpty) {
+        slot = {tag, static_cast<std::uint32_t>(keys_.size())};
+        keys_.push_back(key);
+        return {slot.id, key};
+      }
+      if (slot.tag == tag && keys_[slot.id] == key) return {slot.id, keys_[slot.id]};
+    }
+  }
+
+ private:
+  static constexpr std::uint32_t kEmpty = 0xffffffffu;
+  // 8 bytes a slot, at most half of them used; the keys themselves are kept once, in order.
+  struct Slot {
+    std::uint32_t tag = 0;   // the hash's high bits: most other keys are told apart without a look
+    std::uint32_t id = kEmpty;
+  };
+  void grow() {
+    slots_.assign(slots_.size() * 2, Slot{});
+    const std::size_t mask = slots_.size() - 1;
+    for (std::uint32_t id = 0; id < keys_.size(); ++id) {
+      const std::size_t h = Hash{}(keys_[id]);
+      std::size_t s = h & mask;
+      while (slots_[s].id != kEmpty) s = (s + 1) & mask;
+      slots_[s] = {static_cast<std::uint32_t>(h >> 32), id};
+    }
+  }
+  std::vector<Slot> slots_;
+  std::vector<Key> keys_;
+};
+
+struct MixHash {   // a 64-bit value's bits spread over the low ones (the table's mask)
+  std::size_t operator()(std::uint64_t x) const {
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdULL;
+    x ^= x >> 33;
+    return static_cast<std::size_t>(x);
+  }
+};
+struct NameHash {   // short names (a body's, a wall's): their bytes 8 at a time, mixed
+  std::size_t operator()(std::string_view s) const {
+    std::uint64_t h = s.size() * 0x9e3779b97f4a7c15ULL;
+    std::size_t at = 0;
+    for (; at + 8 <= s.size(); at += 8) {
+      std::uint64_t w;
+      std::memcpy(&w, s.data() + at, 8);
+      h = (h ^ w) * 0x9e3779b97f4a7c15ULL;
+      h ^= h >> 29;
+    }
+    std::uint64_t w = 0;
+    if (at < s.size()) std::memcpy(&w, s.data() + at, s.size() - at);
+    return MixHash{}(h ^ w);
+  }
+};
+
 // Object pairs as dense ids, names hashed once per contact list: a gas has thousands of
 // contacts and each run's are matched against five or six others.
 struct PairTable {
-  std::unordered_map<std::string_view, std::uint32_t> names;
-  std::unordered_map<std::uint64_t, std::uint32_t> pairs;
-  PairTable() {
-    names.reserve(64);
-    pairs.reserve(1024);
-  }
+  FlatIds<std::string_view, NameHash> names;   // views of the contact lists' own strings
+  FlatIds<std::uint64_t, MixHash> pairs;
   // The last few (a, b) met, in that order, with their pair's id: a contact list goes
   // back and forth between a few pairs (pi_billiard_1e8's 31k contacts are two), and
   // comparing two short names costs less than hashing them and the pair (about half of
@@ -147,9 +214,7 @@ struct PairTable {
   std::size_t recent_count = 0, recent_next = 0;
   // The id of each contact's unordered pair of names.
   std::vector<std::uint32_t> ids(const std::vector<ContactRecord>& contacts) {
-    auto name = [&](const std::string& n) {
-      return names.emplace(std::string_view(n), static_cast<std::uint32_t>(names.size())).first;
-    };
+    auto name = [&](const std::string& n) { return names.id(std::string_view(n)); };
     std::vector<std::uint32_t> out(contacts.size());
     // A list that does not go back and forth (a gas: thousands of pairs) stops looking at
     // the last few after its first kTrial contacts if fewer than half of them were there.
@@ -174,11 +239,11 @@ struct PairTable {
         }
       }
       const auto xa = name(contacts[k].a), yb = name(contacts[k].b);
-      const std::uint32_t x = xa->second, y = yb->second;
+      const std::uint32_t x = xa.first, y = yb.first;
       const std::uint64_t key = (static_cast<std::uint64_t>(std::min(x, y)) << 32) | std::max(x, y);
-      out[k] = pairs.emplace(key, static_cast<std::uint32_t>(pairs.size())).first->second;
+      out[k] = pairs.id(key).first;
       if (use_recent) {
-        recent[recent_next] = {xa->first, yb->first, out[k]};
+        recent[recent_next] = {xa.second, yb.second, out[k]};
         recent_next = (recent_next + 1) % kRecent;
         recent_count = std::max(recent_count, recent_next == 0 ? kRecent : recent_next);
       }

@@ -50,6 +50,11 @@ class ContainmentMonitor {
   // Tests only: the moving pairs by the plain x sweep, never through horizontal strips
   // (both must find the same pairs in the same order: test Containment.StripsEqualPlainSweep*).
   void use_plain_sweep(bool plain) { plain_sweep_ = plain; }
+  // Tests only: every moving pair the filters pass goes through the full tests, none is left
+  // out as apart all step (both must give the same record: test Containment.FarPairSkip*);
+  // and how many were left out.
+  void use_full_pair_tests(bool full) { full_pair_tests_ = full; }
+  std::uint64_t far_pairs_skipped() const { return far_pairs_skipped_; }
 
  private:
   struct Barrier {
@@ -108,6 +113,8 @@ class ContainmentMonitor {
   // bodies' positions in x order, their left ends and y intervals, and a cursor past those
   // already swept; strip_of_ per x-order position.
   bool plain_sweep_ = false;
+  bool full_pair_tests_ = false;
+  std::uint64_t far_pairs_skipped_ = 0;
   std::vector<std::uint32_t> strip_of_, strip_start_, strip_cursor_, strip_item_;
   std::vector<double> strip_lo_;
   double max_radius_ = 0.0;                    // of the moving bodies

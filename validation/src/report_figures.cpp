@@ -3,6 +3,8 @@
 // underneath as a thick grey line.
 #include "report_figures.hpp"
 
+#include "physval/validation/series_file.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -61,7 +63,26 @@ std::vector<std::string> split_csv_line(const std::string& line) {
 }  // namespace
 
 std::optional<Table> read_table(const fs::path& file) {
-  std::ifstream in(file);
+  // A series is DIR/series/<scenario>/<label>.bin as `physval run` writes it, or the CSV
+  // of `--series-csv` or `physval series-csv` (either path may be given: the .bin is read
+  // when there is one, else the .csv).
+  fs::path bin = file, csv = file;
+  bin.replace_extension(".bin");
+  csv.replace_extension(".csv");
+  std::error_code ec;
+  if (fs::is_regular_file(bin, ec)) {
+    std::optional<SeriesTable> s = read_series_binary(bin);
+    if (!s) return std::nullopt;
+    Table t;
+    t.names = std::move(s->names);
+    const std::size_t columns = t.names.size();
+    t.columns.assign(columns, std::vector<double>(s->rows));
+    for (std::size_t k = 0; k < s->rows; ++k) {
+      for (std::size_t c = 0; c < columns; ++c) t.columns[c][k] = s->values[k * columns + c];
+    }
+    return t;
+  }
+  std::ifstream in(csv);
   if (!in) return std::nullopt;
   std::string line;
   if (!std::getline(in, line)) return std::nullopt;

@@ -1,11 +1,13 @@
 #include "physval/validation/results_json.hpp"
 
 #include <fcntl.h>
+#include <sys/uio.h>
 #include <unistd.h>
 
 #include <cerrno>
 
 #include <algorithm>
+#include <bit>
 #include <charconv>
 #include <cmath>
 #include <chrono>
@@ -24,7 +26,7 @@
 
 #include "physval/adapters/registry.hpp"
 #include "physval/validation/runner.hpp"
-#include "number_text.hpp"
+#include "physval/validation/series_file.hpp"
 
 namespace physval {
 
@@ -327,34 +329,47 @@ namespace {
 // rename as write_file_atomically does, and no ofstream. `physval run` writes into its
 // staging folder, which replaces --out whole once everything is written (README, `run`),
 // so nothing reads a series file half written; the temporary and the rename were most of
-// each small file's syscalls, and the suite writes about 300 of them.
-void write_whole_file(const std::filesystem::path& path, std::string_view text) {
+// each small file's syscalls, and the suite writes about 300 of them. A file of two pieces
+// (a series file's text lines and its doubles) is written by writev, not joined first.
+void write_whole_file(const std::filesystem::path& path, std::string_view head, std::string_view body = {}) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (fd < 0) throw std::runtime_error("cannot write " + path.string() + ": " + std::strerror(errno));
-  const char* p = text.data();
-  std::size_t left = text.size();
-  while (left > 0) {
-    const ssize_t put = ::write(fd, p, left);
+  std::string_view parts[2] = {head, body};
+  std::size_t first = 0;
+  auto skip_done = [&] {
+    while (first < 2 && parts[first].empty()) ++first;
+  };
+  skip_done();
+  while (first < 2) {
+    iovec io[2];
+    int n = 0;
+    for (std::size_t k = first; k < 2; ++k) io[n++] = {const_cast<char*>(parts[k].data()), parts[k].size()};
+    const ssize_t put = ::writev(fd, io, n);
     if (put < 0 && errno == EINTR) continue;
     if (put <= 0) {
       const int e = put < 0 ? errno : EIO;
       ::close(fd);
       throw std::runtime_error("cannot write " + path.string() + ": " + std::strerror(e));
     }
-    p += put;
-    left -= static_cast<std::size_t>(put);
+    auto left = static_cast<std::size_t>(put);
+    for (; first < 2 && left > 0; ++first) {
+      const std::size_t k = std::min(left, parts[first].size());
+      parts[first].remove_prefix(k);
+      left -= k;
+      if (!parts[first].empty()) break;
+    }
+    skip_done();
   }
   if (::close(fd) != 0) throw std::runtime_error("cannot write " + path.string() + ": " + std::strerror(errno));
 }
 
 }  // namespace
 
-void write_results(const std::filesystem::path& dir, const SuiteResult& result) {
-  // Series first: results.json, written last, is what marks a complete output. The
-  // report's scene player draws every body, so the series hold up to this many.
-  constexpr std::size_t kMaxBodiesInSeries = 400;
-  std::unique_ptr<char[]> buffer;
-  std::size_t buffer_capacity = 0;
+void write_results(const std::filesystem::path& dir, const SuiteResult& result, SeriesFormat format) {
+  // Series first: results.json, written last, is what marks a complete output.
+  std::vector<double> values;   // one buffer for all series: its pages are faulted in once
+  std::unique_ptr<char[]> text;   // --series-csv: the text, likewise
+  std::size_t text_capacity = 0;
   for (const ScenarioResult& sr : result.scenarios) {
     const double cpu0 = thread_cpu_seconds();
     const std::filesystem::path folder = dir / "series" / safe_file_name(sr.scene.name);
@@ -366,58 +381,29 @@ void write_results(const std::filesystem::path& dir, const SuiteResult& result) 
     }
     auto write_series = [&](const RunRecord& r, const std::string& label) {
       if (r.series.time.empty()) return;
-      // std::to_chars gives %.12g's text (what os.precision(12) printed) several times
-      // faster: on circle_gas the series' number formatting was a fifth of the harness.
-      // The text is written through a pointer into a buffer sized for the worst case
-      // (every number at most kMaxNumber characters), then cut to what was written.
-      constexpr std::size_t kMaxNumber = 32;
-      const std::size_t nb = std::min(r.bodies.size(), kMaxBodiesInSeries);
-      std::string header = "t,energy,kinetic,potential,px,py,angular_momentum";
-      for (std::size_t i = 0; i < nb; ++i) header += ",x_" + r.bodies[i].name + ",y_" + r.bodies[i].name;
-      header += '\n';
-      const std::size_t capacity = header.size() + r.series.time.size() * (7 + 2 * nb) * (kMaxNumber + 1);
-      if (capacity > buffer_capacity) {   // one buffer for all series: its pages are faulted in once
-        buffer.reset(new char[capacity]);   // not zeroed: written before read
-        buffer_capacity = capacity;
-      }
-      std::memcpy(buffer.get(), header.data(), header.size());
-      char* o = buffer.get() + header.size();
-      auto put = [&](double v) {
-        if (std::isnan(v)) {
-          std::memcpy(o, "nan", 3);
-          o += 3;
+      const std::string header = series_header(r);
+      const std::size_t columns = series_values(r, values);
+      const std::size_t rows = r.series.time.size();
+      if (format == SeriesFormat::Binary) {
+        // The doubles as they are (series_file.hpp): no text to make, half the CSV's bytes.
+        std::string_view body(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
+        std::string swapped;
+        if constexpr (std::endian::native == std::endian::big) {
+          append_series_binary(swapped, header, values.data(), rows, columns);
+          write_whole_file(folder / (safe_file_name(label) + ".bin"), swapped);
           return;
         }
-        o = to_chars_g12(o, o + kMaxNumber, v);
-      };
-      for (std::size_t k = 0; k < r.series.time.size(); ++k) {
-        const Totals& t = r.series.totals[k];
-        put(r.series.time[k]);
-        for (const double v : {t.energy(), t.kinetic, t.potential, t.momentum.x, t.momentum.y, t.angular_momentum}) {
-          *o++ = ',';
-          put(v);
-        }
-        const auto& st = r.series.states[k];
-        const std::size_t have = std::min(nb, st.size());
-        for (std::size_t i = 0; i < have; ++i) {
-          if (st[i].alive) {
-            *o++ = ',';
-            put(st[i].position.x);
-            *o++ = ',';
-            put(st[i].position.y);
-          } else {
-            std::memcpy(o, ",nan,nan", 8);
-            o += 8;
-          }
-        }
-        for (std::size_t i = have; i < nb; ++i) {
-          std::memcpy(o, ",nan,nan", 8);
-          o += 8;
-        }
-        *o++ = '\n';
+        write_whole_file(folder / (safe_file_name(label) + ".bin"), series_binary_prefix(header, rows, columns), body);
+        return;
       }
+      const std::size_t capacity = series_csv_capacity(header.size(), rows, columns);
+      if (capacity > text_capacity) {
+        text.reset(new char[capacity]);   // not zeroed: written before read
+        text_capacity = capacity;
+      }
+      const char* end = write_series_csv(text.get(), header, values.data(), rows, columns);
       write_whole_file(folder / (safe_file_name(label) + ".csv"),
-                       std::string_view(buffer.get(), static_cast<std::size_t>(o - buffer.get())));
+                       std::string_view(text.get(), static_cast<std::size_t>(end - text.get())));
     };
     for (const RunRecord& r : sr.runs) write_series(r, r.engine);
     if (sr.reference.run) write_series(*sr.reference.run, "reference");
@@ -488,6 +474,10 @@ class JsonStream {
     std::string& t = text_;
     t.clear();
     t += "[\n";
+    char time_text[64];
+    std::size_t time_text_size = 0;
+    double last_time = 0.0;
+    bool have_time = false;
     for (std::size_t k = 0; k < cs.size(); ++k) {
       const ContactRecord& c = cs[k];
       t += open;
@@ -501,8 +491,15 @@ class JsonStream {
       }
       t += to_time;
       if (std::isfinite(c.time)) {
-        char buf[64];
-        t.append(buf, nlohmann::detail::to_chars(buf, buf + sizeof buf, c.time));
+        // A run's contacts come in time order, many in one step at the same time (every
+        // contact a step-end engine reports in a step): the text of the time before is
+        // reused when the double is the same, bit for bit.
+        if (!(have_time && std::memcmp(&c.time, &last_time, sizeof last_time) == 0)) {
+          time_text_size = static_cast<std::size_t>(nlohmann::detail::to_chars(time_text, time_text + sizeof time_text, c.time) - time_text);
+          last_time = c.time;
+          have_time = true;
+        }
+        t.append(time_text, time_text_size);
       } else {
         t += "null";
       }

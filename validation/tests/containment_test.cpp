@@ -420,6 +420,103 @@ TEST(Containment, StripsEqualPlainSweepOnRandomGases) {
 }
 
 
+// Pairs left out as apart all step (their straight relative path farther apart than the
+// radii together) against the full tests for every pair the filters pass: the same whole
+// record after every step (deepest overlap, its time and pair, escapes and their list, the
+// first escape, every skipped-impact graze and the dropped count) on gases of circles and
+// points whose bodies fly straight (grazes), jump through neighbours (passes into each
+// other), turn within a step (bends), rest pressed into each other (overlaps), die and come
+// back, with a group the matrix lets through.
+TEST(Containment, FarPairSkipEqualsFullTestsOnRandomGases) {
+  int escapes_seen = 0, grazes_seen = 0;
+  std::uint64_t skipped = 0;
+  for (unsigned seed = 1; seed <= 12; ++seed) {
+    std::mt19937 rng(100 + seed);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0), prob(0.0, 1.0);
+    Scene scene;
+    scene.name = "gas";
+    const double half = 2.0;
+    const Vec2 c[4] = {{-half, -half}, {half, -half}, {half, half}, {-half, half}};
+    for (int k = 0; k < 4; ++k) {
+      WallDef w;
+      w.name = std::string("w").append(std::to_string(k));
+      w.from = c[k];
+      w.to = c[(k + 1) % 4];
+      scene.walls.push_back(w);
+    }
+    const std::size_t n = 30 + 25 * seed;
+    std::vector<BodyState> states(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      BodyDef b;
+      b.name = std::string("b").append(std::to_string(i));
+      b.shape = i % 13 == 5 ? ShapeKind::Point : ShapeKind::Circle;
+      b.radius = b.shape == ShapeKind::Point ? 0.0 : 0.03 + 0.05 * prob(rng);
+      if (i % 11 == 3) b.group = "ghost";
+      b.position = {1.8 * unit(rng), 1.8 * unit(rng)};
+      scene.bodies.push_back(b);
+      states[i].position = b.position;
+      states[i].velocity = {2.0 * unit(rng), 2.0 * unit(rng)};
+    }
+    scene.collision_matrix.push_back({"ghost", "", CollisionResponse::Ignore});
+    ContainmentMonitor fast(scene), full(scene);
+    full.use_full_pair_tests(true);
+    auto same = [&](int k) {
+      const ContainmentRecord& a = fast.record();
+      const ContainmentRecord& b = full.record();
+      const std::string where = "seed " + std::to_string(seed) + " step " + std::to_string(k);
+      EXPECT_EQ(a.max_penetration, b.max_penetration) << where;
+      EXPECT_EQ(a.max_penetration_time, b.max_penetration_time) << where;
+      EXPECT_EQ(a.max_penetration_what, b.max_penetration_what) << where;
+      EXPECT_EQ(a.escaped_bodies, b.escaped_bodies) << where;
+      EXPECT_EQ(a.escaped_list, b.escaped_list) << where;
+      EXPECT_EQ(a.first_escape_time, b.first_escape_time) << where;
+      EXPECT_EQ(a.first_escape, b.first_escape) << where;
+      EXPECT_EQ(a.grazes.size(), b.grazes.size()) << where;
+      for (std::size_t g = 0; g < std::min(a.grazes.size(), b.grazes.size()); ++g) {
+        EXPECT_EQ(a.grazes[g].a, b.grazes[g].a) << where;
+        EXPECT_EQ(a.grazes[g].b, b.grazes[g].b) << where;
+        EXPECT_EQ(a.grazes[g].time, b.grazes[g].time) << where;
+        EXPECT_EQ(a.grazes[g].depth, b.grazes[g].depth) << where;
+      }
+      EXPECT_EQ(a.grazes_dropped, b.grazes_dropped) << where;
+      return !::testing::Test::HasFailure();
+    };
+    fast.start(states);
+    full.start(states);
+    ASSERT_TRUE(same(0));
+    const double h = 1.0 / 60.0;
+    for (int k = 1; k <= 150; ++k) {
+      for (std::size_t i = 0; i < n; ++i) {
+        BodyState& s = states[i];
+        if (prob(rng) < 0.005) s.alive = !s.alive;
+        const double r = prob(rng);
+        if (r < 0.02) {
+          s.position = s.position + s.velocity * (20.0 * h);   // a jump, through a neighbour now and then
+        } else if (r < 0.06) {
+          const Vec2 v0 = s.velocity;   // turns within the step: a bent path
+          s.velocity = {2.0 * unit(rng), 2.0 * unit(rng)};
+          s.position = s.position + (v0 + s.velocity) * (0.25 * h);
+        } else if (i % 7 == 0 && i + 1 < n) {
+          s.position = states[i + 1].position + Vec2{0.05 * unit(rng), 0.05 * unit(rng)};   // pressed into another
+        } else {
+          s.position = s.position + s.velocity * h;   // straight
+        }
+        for (double* x : {&s.position.x, &s.position.y}) *x = std::clamp(*x, -half + 0.01, half - 0.01);
+      }
+      fast.observe(k * h, states);
+      full.observe(k * h, states);
+      ASSERT_TRUE(same(k));
+    }
+    escapes_seen += fast.record().escaped_bodies.value_or(0) > 0 ? 1 : 0;
+    grazes_seen += fast.record().grazes.empty() ? 0 : 1;
+    skipped += fast.far_pairs_skipped();
+    EXPECT_EQ(full.far_pairs_skipped(), 0u);
+  }
+  EXPECT_GT(escapes_seen, 6);    // the gases do pass bodies into each other
+  EXPECT_GT(grazes_seen, 6);     // and keep skipped-impact grazes
+  EXPECT_GT(skipped, 10000u);    // and most pairs are apart
+}
+
 // The barrier test's open box (a body whose swept box lies inside every barrier box's
 // outside skips the barriers): one step from anywhere inside a walled square to anywhere
 // around it, 4000 times, held against the geometry worked out here: an end beyond a wall

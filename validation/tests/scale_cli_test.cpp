@@ -42,7 +42,7 @@ TEST(ScaleCli, SecondRunReadsTheCacheTheFirstWrote) {
   EXPECT_EQ(fs::last_write_time(fs::directory_iterator(root / "cache")->path()), written);   // read, not rewritten
   ASSERT_EQ(physval("run" + scenes + " --no-cache -j 1 --out " + (root / "c").string()), 0);
   // The per-engine series (no timings in them) are identical with and without the cache, at -j 2 and -j 1.
-  for (const char* f : {"series/head_on_elastic/core.csv", "series/equal_mass_swap/core.csv"}) {
+  for (const char* f : {"series/head_on_elastic/core.bin", "series/equal_mass_swap/core.bin"}) {
     EXPECT_EQ(read(root / "a" / f), read(root / "c" / f)) << f;
     EXPECT_EQ(read(root / "b" / f), read(root / "c" / f)) << f;
     EXPECT_FALSE(read(root / "a" / f).empty()) << f;

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "physval/validation/series_file.hpp"
 #include "physval/validation/suite.hpp"
 
 namespace physval {
@@ -53,9 +54,11 @@ class StagedOutputFolder {
   bool committed_ = false;
 };
 
-// DIR/results.json, plus DIR/series/<scenario>/<engine>.csv (time series for plots:
-// t, energy, kinetic, potential, px, py, angular_momentum, then x_i, y_i of each body).
-void write_results(const std::filesystem::path& dir, const SuiteResult& result);
+// DIR/results.json, plus DIR/series/<scenario>/scene.json and <engine>.bin (time series for
+// plots and the player: t, energy, kinetic, potential, px, py, angular_momentum, then x_i,
+// y_i of each body; series_file.hpp), or <engine>.csv with SeriesFormat::Csv.
+void write_results(const std::filesystem::path& dir, const SuiteResult& result,
+                   SeriesFormat series = SeriesFormat::Binary);
 
 // `--overhead FILE`: the harness's cost per scenario next to the engines' stepping (README
 // "Running at scale", "Harness overhead"), all CPU seconds. `process_cpu_seconds`: user +
