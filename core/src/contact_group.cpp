@@ -725,7 +725,8 @@ bool engage_contact_group(World& w, std::span<const std::uint32_t> members) {
   // reach; a larger group is granular (granular.cpp).
   bool granular = members.size() > kMaxMembers ||
                   !plan_group_reach(w, g.members, w.group_dt, kMaxMembers, -1, add, merge, false) || !merge.empty();
-  if (granular && !plan_group_reach(w, g.members, w.group_dt, static_cast<std::size_t>(-1), -1, add, merge, true)) {
+  if (granular && (!w.granular_enabled ||
+                   !plan_group_reach(w, g.members, w.group_dt, static_cast<std::size_t>(-1), -1, add, merge, true))) {
     return false;
   }
   for (std::uint32_t m : g.members) {
@@ -817,10 +818,12 @@ void hide_contact_groups(World& w, const StepContext& ctx) {
     bool ok = false;
     if (w.group_disturbed == kNone) {
       ok = plan_group_reach(w, g.members, ctx.dt, g.granular ? unlimited : kMaxMembers, self, add, merge, g.granular);
-      if (!ok && !g.granular && plan_group_reach(w, g.members, ctx.dt, unlimited, self, add, merge, true)) {
+      if (!ok && !g.granular && w.granular_enabled &&
+          plan_group_reach(w, g.members, ctx.dt, unlimited, self, add, merge, true)) {
         to_granular(g);   // over kMaxMembers, or something static within reach: granular from here
         ok = true;
       }
+      if (ok && !merge.empty() && !w.granular_enabled) ok = false;   // (exact groups do not merge)
     }
     if (ok) {
       if (!merge.empty()) to_granular(g);
@@ -1012,7 +1015,7 @@ static void step_group(World& w, Group& g, const StepContext& ctx, std::vector<G
     if (convert || qbox.contains(swept)) break;
     pad *= 4.0;
   }
-  if (convert && contact_groups_allowed(w)) {   // the step again, granular (nothing written yet)
+  if (convert && contact_groups_allowed(w) && w.granular_enabled) {   // the step again, granular (nothing written yet)
     to_granular(g);
     advance_granular(w, g, ctx, next, swept_out);
     return;
@@ -1155,6 +1158,12 @@ void advance_contact_groups(World& w, const StepContext& ctx) {
       }
     }
     if (i == done.size()) break;
+    if (!w.granular_enabled) {   // [core] dense_contact = "events": no granular group to take both
+      w.group_disturbed = done[i].members.front();
+      w.group_disturbed_time = ctx.t0;
+      w.group_why = "another group came within reach of it in the step (dense_contact = \"events\")";
+      break;
+    }
     Group merged;
     merged.granular = true;
     merged.fresh = true;

@@ -66,7 +66,7 @@ class EventLoop {
         fast_isolated_(w.impact_law == ImpactLaw::Simultaneous && !w.any_rules && !w.any_forces && !w.varying_forces &&
                        !w.coupled()),
         zeno_tails_(w.zeno_tails()),
-        storms_(contact_groups_allowed(w)) {
+        storms_(contact_groups_allowed(w) && w.granular_enabled) {
     // A few faces: their boxes, as StaticGeometry builds them, to skip its query for
     // a box that meets none (most bodies of a walled gas, away from the walls).
     if (w.statics.segments.size() <= kFewFaces) {

@@ -864,7 +864,7 @@ void engage_storm_groups(World& w, const StepContext& ctx) {
     w.storm_count[x] = 0;
   }
   w.storm_bodies.clear();
-  if (hot.empty() || !contact_groups_allowed(w) || w.group_disturbed != kNone) return;
+  if (hot.empty() || !contact_groups_allowed(w) || !w.granular_enabled || w.group_disturbed != kNone) return;
   std::sort(hot.begin(), hot.end());
   std::vector<char> taken(w.size(), 0);
   for (const Group& g : w.contact_groups) {

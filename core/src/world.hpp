@@ -325,6 +325,7 @@ struct World {
   double granular_first_time = -1.0, granular_worst_residual = 0.0;
   std::vector<std::uint32_t> storm_count;   // per body, this step; empty when unused
   std::vector<std::uint32_t> storm_bodies;  // bodies with a count to reset
+  bool granular_enabled = true;   // [core] dense_contact = "granular" (default) or "events"
 
   // ---- convex corners (convex_cap.cpp): bodies riding a segment end's cap, the circle of
   // radius r about the corner their centre moves on (a curved support), by body index.

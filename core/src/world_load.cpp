@@ -46,6 +46,11 @@ std::vector<OptionSpec> core_option_specs() {
                 "by the lecture pass, impacts are no longer exact and the run stops as diverged. "
                 "0: 1,000,000 + 100 per body",
         OptionRange::between(0, 1e9)});
+  s.push_back({"dense_contact", std::string("granular"), {"granular", "events"},
+               "exact mode: bodies in persistent contact with several others (a pile's collapse, a "
+               "group its holds cannot hold, over 16 bodies) are moved by nonsmooth contact dynamics "
+               "(granular: first order, said in limits_hit); events: left to exact impacts (a storm "
+               "of them may be slow, a hold it cannot justify is reported diverged)"});
   s.push_back({"rest_speed", 0.0, {},
                "m/s: an impact against a surface the body is pressed into, leaving slower than this, "
                "settles into resting contact. 0: |a_n| dt / 16 (velocity_verlet, rk4) or 1.5 |a_n| dt "
@@ -149,6 +154,7 @@ void read_options(World& w, const Scene& scene) {
   if (!(w.cell_size >= 0.0) || !std::isfinite(w.cell_size)) throw std::invalid_argument("core: cell_size must be >= 0");
   w.max_events_option = opt.get_int("max_events_per_step");
   if (w.max_events_option < 0) throw std::invalid_argument("core: max_events_per_step must be >= 0");
+  w.granular_enabled = opt.get_string("dense_contact") == "granular";
   w.rest_speed_option = opt.get_double("rest_speed");
   if (!(w.rest_speed_option >= 0.0) || !std::isfinite(w.rest_speed_option)) {
     throw std::invalid_argument("core: rest_speed must be >= 0");
