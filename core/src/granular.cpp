@@ -604,8 +604,17 @@ void substep(World& w, Group& g, Scratch& s, double h, double dt, double t_abs) 
   const double ptol = 1e-12 * w.length_scale;
   thread_local std::vector<Kick> kicks;
   thread_local std::vector<std::int32_t> pdeg;
-  for (int round = 0; round < 8; ++round) {
-    find_contacts(w, g, s, 0.0, ptol, s.proj);
+  // (contacts within twice the deepest overlap join the projection from the start: pushing
+  // a body out moves it by up to that much into its neighbours)
+  double reach_skin = ptol;
+  for (int round = 0; round < 32; ++round) {
+    find_contacts(w, g, s, 0.0, reach_skin, s.proj);
+    double deepest = 0.0;
+    for (const Con& c : s.proj) deepest = std::max(deepest, -c.gap);
+    if (2.0 * deepest > reach_skin) {
+      reach_skin = 2.0 * deepest;
+      find_contacts(w, g, s, 0.0, reach_skin, s.proj);
+    }
     bool moved = false;
     for (int it = 0; it < 256; ++it) {
       double worst = 0.0;
