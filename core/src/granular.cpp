@@ -6,26 +6,29 @@
 // built for dense rigid granular matter (Moreau and Jean's nonsmooth contact dynamics,
 // LMGC90, Siconos) step the contact problem in time instead. core does the latter for such a
 // group: on sub-steps h = dt / kSubsteps,
-//   1. every contact that can close within the sub-step (its gap below what the two bodies'
-//      speeds and forces can cover in h) is a unilateral constraint;
+//   1. every contact that can close within the sub-step (its gap below twice what the two
+//      bodies' speeds and forces can cover in h) is a unilateral constraint;
 //   2. the free velocities v* = v + h a take the contact impulses p that satisfy, at every
 //      contact at once, Signorini at the velocity level (p_n >= 0, w_n+ >= b, complementary;
-//      b = -gap / h for an open contact, so it may close exactly by the sub-step's end, and
-//      b = e w_n- for an impact faster than the rest speed: Newton's restitution) and Coulomb
-//      (|p_t| <= mu p_n, sticking where the tangential speed can be brought to 0, else
-//      sliding against it with mu_k): projected Gauss-Seidel, warm-started from the last
-//      sub-step, iterated until no velocity changes by more than 1e-13 of the speeds;
+//      b = -gap / h for an open contact, so it may close exactly by the sub-step's end; for an
+//      impact faster than the rest speed b = -e w_n- plus the relative force acceleration
+//      over h: Newton's restitution at the sub-step's start) and Coulomb (|p_t| <= mu_s p_n
+//      where the tangential speed can be brought to 0, else mu_k against it): projected
+//      Gauss-Seidel with nonsmooth conjugate gradients, warm-started from the last sub-step,
+//      to 1e-10 of the sub-step's speeds (it stops when its sweeps stagnate: counted);
 //   3. a body that took an impulse moves by h v+ (Moreau's theta = 1: a body at rest stays
 //      exactly at rest); a body that took none follows its exact parabola;
 //   4. any overlap left (the contact normals turn within a sub-step) is projected off, mass
 //      weighted, to 1e-12 of the scene's size.
 // Energy: with restitution 0 the impulses are the kinetic-energy-metric projection of v*
 // onto the admissible velocities, which contain 0, so they never add kinetic energy; where
-// Newton's law at several contacts at once would, the sub-step is solved again with
-// restitution 0 (as the engine's simultaneous law does). First order in time, not exact:
-// core says so in limits_hit. A group whose bodies are all slower than the rest speed and
-// whose contacts hold it (the same problem from rest, with static friction, leaves every
-// body at rest) sleeps: its velocities are set to 0 and it is not stepped until a body joins.
+// the bounces would (at several contacts at once, or against the field's work over the
+// sub-step), or cannot all hold, the sub-step's bounces are perfectly inelastic. The sweeps
+// visit contacts in an order of the geometry alone (bottom up), so no numbering or mirror
+// image changes a bit. First order in time, not exact: core says so in limits_hit. A group
+// whose bodies are all slower than the rest speed and whose contacts hold it (the same
+// problem from rest, with static friction, leaves every body at rest) sleeps: its velocities
+// are set to 0 and it is not stepped until a body joins. README, "Piles and dense groups".
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
