@@ -42,6 +42,7 @@ namespace physval::core_detail {
 namespace {
 
 constexpr int kSubsteps = 4;
+constexpr int kMaxSubsteps = 64;
 constexpr int kMaxSweeps = 1000;
 constexpr double kEps = 2.220446049250313e-16;
 
@@ -752,17 +753,29 @@ void granular_step(World& w, Group& g, const StepContext& ctx, std::vector<doubl
     s.smooth_face = false;
     find_fixed(w, g, s, ctx.dt, s.fixed);
     s.recorded.clear();
-    const double h = ctx.dt / kSubsteps;
-    for (int k = 0; k < kSubsteps; ++k) substep(w, g, s, h, ctx.dt, ctx.t0 + k * h);
+    // At least kSubsteps sub-steps, more where a fast member would cross more than a quarter of
+    // the smallest radius in one (a ball thrown into a pile: its impact is resolved at a
+    // sub-step's resolution), at most kMaxSubsteps.
+    double vmax = 0.0, amax = 0.0, rmin = INFINITY;
+    for (std::size_t q = 0; q < M; ++q) {
+      vmax = std::max(vmax, length(s.v[q]));
+      amax = std::max(amax, length(s.a[q]));
+      rmin = std::min(rmin, s.rad[q]);
+    }
+    int subs = kSubsteps;
+    if (rmin > 0.0) {
+      const double cross = (vmax + amax * ctx.dt) * ctx.dt / (0.25 * rmin);
+      if (cross > kSubsteps) subs = static_cast<int>(std::min<double>(kMaxSubsteps, std::ceil(cross)));
+    }
+    const double h = ctx.dt / subs;
+    for (int k = 0; k < subs; ++k) substep(w, g, s, h, ctx.dt, ctx.t0 + k * h);
     if (s.smooth_face && w.group_disturbed == kNone) {   // contacts there take the faces' own normals
       w.group_disturbed = g.members.front();
       w.group_disturbed_time = ctx.t0;
       w.group_why = "a face near it has interpolated normals (a surface), which the granular mode does not model";
     }
     // asleep: every body slower than the rest speed, and the contacts hold the group at rest
-    double amax = 0.0;
     bool slow = true;
-    for (std::size_t q = 0; q < M; ++q) amax = std::max(amax, length(s.a[q]));
     for (std::size_t q = 0; q < M && slow; ++q) slow = length(s.v[q]) <= w.rest_speed(amax, ctx.dt);
     if (slow && amax > 0.0 && holds_at_rest(w, g, s, h, ctx.dt)) {
       g.sleeping = true;

@@ -248,7 +248,21 @@ struct PileCase {
   double e;
   std::uint64_t seed;
   double mu = 0.5;
+  double bullet = 0.0;   // > 0: a ball (e 0.9) shot down into the pile from near the lid at this speed
 };
+
+Scene pile_scene(const PileCase& c) {
+  Scene s = make_circle_pile(c.n, c.e, c.mu, c.seed);
+  if (c.bullet > 0.0) {
+    BodyDef b = s.bodies.front();
+    b.name = "bullet";
+    b.restitution = 0.9;
+    b.position = {0.5 * s.walls[0].to.x + 0.013, s.walls[1].to.y - 0.15};
+    b.velocity = {0.2 * c.bullet, -c.bullet};
+    s.bodies.push_back(b);
+  }
+  return s;
+}
 
 class CorePileSettles : public ::testing::TestWithParam<PileCase> {};
 
@@ -265,12 +279,12 @@ TEST_P(CorePileSettles, SettlesWithoutOverlapCapOrEnergyGain) {
   // A sanitized Debug build is 10-20x slower; it checks the same code on the piles of 10-50.
   if (c.n > 50) GTEST_SKIP() << "pile of " << c.n << ": Release build only (too slow under the sanitizers)";
 #endif
-  Sim sim(make_circle_pile(c.n, c.e, c.mu, c.seed));
+  Sim sim(pile_scene(c));
   // Energy never rises, but for the micro-bounce of a pressed pair that nothing can hold
   // (it leaves at half the rest speed v_r = g dt / 16): at most m (v_r / 2)^2 / 2 per body
   // and step. That is the README's stated exception, asserted as a bound.
   const double v_r = g * dt / 16.0;
-  const double micro_bounces = c.n * 0.5 * (0.5 * v_r) * (0.5 * v_r);
+  const double micro_bounces = static_cast<double>(sim.scene.bodies.size()) * 0.5 * (0.5 * v_r) * (0.5 * v_r);
   sim.engine.read_states(sim.states);
   const double E0 = energy(sim.states, sim.scene);
   double E_prev = INFINITY;
@@ -288,6 +302,13 @@ TEST_P(CorePileSettles, SettlesWithoutOverlapCapOrEnergyGain) {
     ASSERT_LE(E, E0 + 1e-12 * std::fabs(E0)) << "step " << k;
     E_prev = E;
     ASSERT_LE(deepest_overlap(sim.states, sim.scene), 1e-9) << "step " << k;   // every step
+    // and nothing left the box (a body through a wall overlaps nothing)
+    const double W = sim.scene.walls[0].to.x, H = sim.scene.walls[1].to.y;
+    for (std::size_t i = 0; i < sim.states.size(); ++i) {
+      const Vec2 p = sim.states[i].position;
+      const double r = sim.scene.bodies[i].radius - 1e-9;
+      ASSERT_TRUE(p.x >= r && p.x <= W - r && p.y >= r && p.y <= H - r) << "step " << k << ", body " << i;
+    }
     last_events = sim.engine.last_step_stats().events;
   }
   EXPECT_LE(deepest_overlap(sim.states, sim.scene), 1e-9);
@@ -304,12 +325,18 @@ INSTANTIATE_TEST_SUITE_P(Piles, CorePileSettles,
                                            PileCase{200, 0.3, 7},
                                            // mu 0.2: a projection that pushed bodies into
                                            // neighbours it had not listed left 4e-5 m overlaps
-                                           PileCase{50, 0.6, 1, 0.2}, PileCase{200, 0.3, 1, 0.2}),
+                                           PileCase{50, 0.6, 1, 0.2}, PileCase{200, 0.3, 1, 0.2},
+                                           // a ball shot into the collapsing pile at 10-40 m/s
+                                           PileCase{50, 0.3, 1, 0.5, 10.0}, PileCase{50, 0.3, 1, 0.5, 40.0},
+                                           PileCase{100, 0.6, 6, 0.2, 25.0}),
                          [](const auto& test_info) {
                            return "n" + std::to_string(test_info.param.n) + "_e" +
                                   std::to_string(static_cast<int>(test_info.param.e * 10)) + "_seed" +
                                   std::to_string(test_info.param.seed) + "_mu" +
-                                  std::to_string(static_cast<int>(test_info.param.mu * 10));
+                                  std::to_string(static_cast<int>(test_info.param.mu * 10)) +
+                                  (test_info.param.bullet > 0.0
+                                       ? "_bullet" + std::to_string(static_cast<int>(test_info.param.bullet))
+                                       : std::string());
                          });
 
 // Frictionless piles (mu = 0): held only where the normals alone balance each body's weight
