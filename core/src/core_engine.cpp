@@ -224,10 +224,11 @@ std::vector<std::string> CoreEngine::limits_hit() const {
     std::ostringstream os;
     os << "granular contact from t = " << w.granular_first_time << " s (" << w.granular_steps
        << " group step(s)): bodies in persistent contact with several others (a pile, a collapse) moved by "
-          "nonsmooth contact dynamics (Moreau-Jean time stepping on sub-steps of dt/4, Signorini and Coulomb at the "
-          "velocity level solved at every contact at once, overlaps projected off): first order, not exact";
+          "nonsmooth contact dynamics (Moreau-Jean time stepping on sub-steps of dt/4 or less, Signorini and Coulomb "
+          "at the velocity level solved at every contact at once, overlaps projected off): first order, not exact";
     if (w.granular_unconverged > 0) {
-      os << "; " << w.granular_unconverged << " sub-step solve(s) stopped at the sweep limit (largest residual "
+      os << "; " << w.granular_unconverged
+         << " sub-step solve(s) stopped short of 1e-10 of their speeds, their sweeps stagnating (largest residual "
          << w.granular_worst_residual << " m/s)";
     }
     out.push_back(os.str());
