@@ -860,6 +860,8 @@ static void check_reach(World& w, const Box& swept, const StepContext& ctx, doub
   const double tol = 1e-9 * scale;
   for (std::uint32_t j = 0; j < w.size() && w.group_disturbed == kNone; ++j) {
     if (!w.alive(j)) continue;
+    // a granular group's static neighbours are its fixed contacts (granular_step checks them)
+    if (member_boxes != nullptr && w.is_static(j)) continue;
     const Vec2 p0 = w.group_p0[j], p1 = w.pos[j];
     const Vec2 p2 = p0 + ctx.dt * w.group_v0[j];
     const double r = w.radius[j] + (w.acc.empty() ? 0.0 : length(group_force_acc(w, j))) * ctx.dt * ctx.dt + tol;

@@ -480,9 +480,17 @@ void load(const World& w, const Group& g, Scratch& s) {
 // The static bodies within reach of the group over the step.
 void find_fixed(const World& w, const Group& g, const Scratch& s, double dt, std::vector<std::uint32_t>& out) {
   out.clear();
+  // (each member's reach as the group's plan takes it: an impulse may pass a body up to twice
+  // the group's fastest speed)
+  double vmax = 0.0, amax = 0.0;
+  for (std::size_t q = 0; q < g.members.size(); ++q) {
+    vmax = std::max(vmax, length(s.v[q]));
+    amax = std::max(amax, length(s.a[q]));
+  }
   double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
   for (std::size_t q = 0; q < g.members.size(); ++q) {
-    const double r = s.rad[q] + length(s.v[q]) * dt + length(s.a[q]) * dt * dt + 1e-9 * w.length_scale;
+    const double reach = std::max(length(s.v[q]) * dt + length(s.a[q]) * dt * dt, 2.0 * vmax * dt + 5.0 * amax * dt * dt);
+    const double r = s.rad[q] + reach + 1e-9 * w.length_scale;
     x0 = std::min(x0, s.x[q].x - r);
     y0 = std::min(y0, s.x[q].y - r);
     x1 = std::max(x1, s.x[q].x + r);
@@ -801,6 +809,22 @@ void granular_step(World& w, Group& g, const StepContext& ctx, std::vector<doubl
     }
     const double h = ctx.dt / subs;
     for (int k = 0; k < subs; ++k) substep(w, g, s, h, ctx.dt, ctx.t0 + k * h);
+    // a static body a member reached that was not among the group's fixed contacts (beyond
+    // every reach the step was planned with): core found no contact with it, a broken guarantee
+    for (std::uint32_t j = 0; j < w.size() && w.group_disturbed == kNone; ++j) {
+      if (!w.is_static(j) || (w.flags[j] & kAlive) == 0) continue;
+      if (std::find(s.fixed.begin(), s.fixed.end(), j) != s.fixed.end()) continue;
+      const double r = w.radius[j] + 1e-9 * w.length_scale;
+      for (std::size_t q = 0; q < M; ++q) {
+        const double* b = &s.boxes[4 * q];
+        if (w.pos[j].x + r < b[0] || w.pos[j].x - r > b[2] || w.pos[j].y + r < b[1] || w.pos[j].y - r > b[3]) continue;
+        w.group_disturbed = j;
+        w.group_disturbed_time = ctx.t0;
+        w.group_why = "a member of the granular group reached static body '" + w.name(j) +
+                      "' beyond the reach its step was planned with";
+        break;
+      }
+    }
     if (s.smooth_face && w.group_disturbed == kNone) {   // contacts there take the faces' own normals
       w.group_disturbed = g.members.front();
       w.group_disturbed_time = ctx.t0;
