@@ -600,6 +600,11 @@ bool contact_groups_allowed(const World& w) {
          !w.newtonian;
 }
 
+bool granular_allowed(const World& w) {
+  return w.mode == CollisionMode::Exact && !w.any_rules && w.emitters.empty() && !w.acc.empty() && !w.newtonian &&
+         w.granular_enabled;
+}
+
 // How far body i can go in a step of dt (its speed, its force and a contact's push).
 static double reach_of(const World& w, std::uint32_t i, double dt, double ascale) {
   const double a = w.acc.empty() ? 0.0 : length(group_force_acc(w, i));
@@ -709,7 +714,8 @@ bool plan_group_reach(const World& w, const std::vector<std::uint32_t>& members,
 }
 
 bool engage_contact_group(World& w, std::span<const std::uint32_t> members) {
-  if (!contact_groups_allowed(w)) return false;
+  const bool exact_ok = contact_groups_allowed(w);
+  if (!exact_ok && !granular_allowed(w)) return false;
   if (members.size() < 2) return false;
   for (std::uint32_t m : members) {
     if (!w.dynamic(m) || m >= w.scene_bodies || (w.flags[m] & (kPoint | kParticle | kDestroyOnHit)) != 0) return false;
@@ -723,9 +729,9 @@ bool engage_contact_group(World& w, std::span<const std::uint32_t> members) {
   std::vector<std::size_t> merge;
   // The exact group mode up to kMaxMembers bodies, nothing static or another group within
   // reach; a larger group is granular (granular.cpp).
-  bool granular = members.size() > kMaxMembers ||
+  bool granular = !exact_ok || members.size() > kMaxMembers ||
                   !plan_group_reach(w, g.members, w.group_dt, kMaxMembers, -1, add, merge, false) || !merge.empty();
-  if (granular && (!w.granular_enabled ||
+  if (granular && (!granular_allowed(w) ||
                    !plan_group_reach(w, g.members, w.group_dt, static_cast<std::size_t>(-1), -1, add, merge, true))) {
     return false;
   }
@@ -818,7 +824,7 @@ void hide_contact_groups(World& w, const StepContext& ctx) {
     bool ok = false;
     if (w.group_disturbed == kNone) {
       ok = plan_group_reach(w, g.members, ctx.dt, g.granular ? unlimited : kMaxMembers, self, add, merge, g.granular);
-      if (!ok && !g.granular && w.granular_enabled &&
+      if (!ok && !g.granular && granular_allowed(w) &&
           plan_group_reach(w, g.members, ctx.dt, unlimited, self, add, merge, true)) {
         to_granular(g);   // over kMaxMembers, or something static within reach: granular from here
         ok = true;
@@ -884,7 +890,14 @@ static void check_reach(World& w, const Box& swept, const StepContext& ctx, doub
 }
 
 // A granular group's step (granular.cpp), then its split.
-static void advance_granular(World& w, Group& g, const StepContext& ctx, std::vector<Group>& next, Box& swept) {
+static void advance_granular(World& w, Group& g, const StepContext& ctx_step, std::vector<Group>& next, Box& swept) {
+  // a group engaged inside this step (an impact storm) takes what is left of it
+  StepContext ctx = ctx_step;
+  if (g.start > 0.0) {
+    ctx.t0 += g.start;
+    ctx.dt -= g.start;
+    g.start = 0.0;
+  }
   std::vector<Vec2> p0, v0;
   for (std::uint32_t m : g.members) {
     p0.push_back(w.pos[m]);
@@ -1017,7 +1030,7 @@ static void step_group(World& w, Group& g, const StepContext& ctx, std::vector<G
     if (convert || qbox.contains(swept)) break;
     pad *= 4.0;
   }
-  if (convert && contact_groups_allowed(w) && w.granular_enabled) {   // the step again, granular (nothing written yet)
+  if (convert && granular_allowed(w)) {   // the step again, granular (nothing written yet)
     to_granular(g);
     advance_granular(w, g, ctx, next, swept_out);
     return;
@@ -1125,6 +1138,7 @@ void advance_contact_groups(World& w, const StepContext& ctx) {
   // taken back to the step's start and stepped again as one granular group.
   struct Stepped {
     std::vector<std::uint32_t> members;
+    bool midstep = false;   // engaged inside the step: its members' step-start state is not in group_p0
     std::size_t first = 0, end = 0;          // its groups in `next`
     std::size_t ev_first = 0, ev_end = 0;    // its contact events in w.contacts
     Box swept;
@@ -1134,6 +1148,7 @@ void advance_contact_groups(World& w, const StepContext& ctx) {
   const auto run = [&](Group& g) {
     Stepped st;
     st.members = g.members;
+    st.midstep = g.start > 0.0;
     st.first = next.size();
     st.ev_first = w.contacts.size();
     step_group(w, g, ctx, next, st.swept);
@@ -1160,7 +1175,9 @@ void advance_contact_groups(World& w, const StepContext& ctx) {
       }
     }
     if (i == done.size()) break;
-    if (!w.granular_enabled) {   // [core] dense_contact = "events": no granular group to take both
+    if (!w.granular_enabled || done[i].midstep || done[j].midstep) {
+      // [core] dense_contact = "events": no granular group to take both; or one of them began
+      // inside the step (no common start to step them again from)
       w.group_disturbed = done[i].members.front();
       w.group_disturbed_time = ctx.t0;
       w.group_why = "another group came within reach of it in the step (dense_contact = \"events\")";

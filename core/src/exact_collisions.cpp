@@ -66,7 +66,7 @@ class EventLoop {
         fast_isolated_(w.impact_law == ImpactLaw::Simultaneous && !w.any_rules && !w.any_forces && !w.varying_forces &&
                        !w.coupled()),
         zeno_tails_(w.zeno_tails()),
-        storms_(contact_groups_allowed(w) && w.granular_enabled) {
+        storms_(granular_allowed(w)) {
     // A few faces: their boxes, as StaticGeometry builds them, to skip its query for
     // a box that meets none (most bodies of a walled gas, away from the walls).
     if (w.statics.segments.size() <= kFewFaces) {
@@ -108,6 +108,7 @@ class EventLoop {
       } else {
         process(e);
       }
+      if (w_.storm_bail) storm_now(e.time);
     }
   }
 
@@ -1426,6 +1427,21 @@ class EventLoop {
       if (dot(w_.vel[i], n) <= 1024.0 * 2.220446049250313e-16 * length(w_.vel[i])) return true;
     }
     return false;
+  }
+
+  // An impact storm inside this step (a body met more than kStormBail times by pressed, slow pair
+  // impacts: a pile's collapse that would run to the event cap): every body is put at t, the
+  // storm's bodies become a granular group that takes the rest of the step (granular.cpp), and
+  // the event loop goes on without them, every other body's events found again from t.
+  void storm_now(double t) {
+    w_.storm_bail = false;
+    for (std::uint32_t i = 0; i < w_.size(); ++i) {
+      if (!tails_.empty()) unwind_tail(i, t, false);
+      if (w_.dynamic(i)) w_.advance(i, t);
+    }
+    if (!engage_storm_groups_now(w_, ctx_, t)) return;
+    for (std::uint32_t i = 0; i < w_.size(); ++i) ++w_.version[i];
+    schedule_all(t);
   }
 
   void finish_with_lecture_pass(double t) {

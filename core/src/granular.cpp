@@ -68,6 +68,7 @@ struct Con {
 
 struct Scratch {
   std::vector<Vec2> x, v, a, vs, x0;
+  std::vector<Vec2> field;   // each member's uniform field (its potential energy's)
   std::vector<double> inv, rad;
   std::vector<std::uint32_t> order;
   std::vector<Con> cons, proj;
@@ -464,6 +465,7 @@ void load(const World& w, const Group& g, Scratch& s) {
   s.x.resize(M);
   s.v.resize(M);
   s.a.resize(M);
+  s.field.resize(M);
   s.inv.resize(M);
   s.rad.resize(M);
   for (std::size_t q = 0; q < M; ++q) {
@@ -471,6 +473,7 @@ void load(const World& w, const Group& g, Scratch& s) {
     s.x[q] = w.pos[m];
     s.v[q] = w.vel[m];
     s.a[q] = g.acc[q];
+    s.field[q] = (w.flags[m] & kNoGravity) ? Vec2{} : w.gravity;
     s.inv[q] = w.inv_mass[m];
     s.rad[q] = w.radius[m];
   }
@@ -507,6 +510,10 @@ void find_fixed(const World& w, const Group& g, const Scratch& s, double dt, std
 // One sub-step of length h. t_abs: the sub-step's start (absolute time).
 void substep(World& w, Group& g, Scratch& s, double h, double dt, double t_abs) {
   const std::size_t M = g.members.size();
+  // forces that depend on the velocity (drag, wind, thrust): taken at the sub-step's start
+  if (w.varying_forces) {
+    for (std::size_t q = 0; q < M; ++q) s.a[q] = body_acceleration(w, g.members[q], s.v[q]);
+  }
   const double skin = 1e-9 * w.length_scale;
   find_contacts(w, g, s, h, skin, s.cons);
   // warm start, scaled to this sub-step
@@ -583,15 +590,17 @@ void substep(World& w, Group& g, Scratch& s, double h, double dt, double t_abs) 
     }
   };
   move();
-  // The group's energy (kinetic and the field's potential), before and after the sub-step.
+  // The group's energy (kinetic and the field's potential), before and after the sub-step, less
+  // the work of the other forces (drag, wind, thrust) over it.
   const auto energy = [&](const std::vector<Vec2>& x, const std::vector<Vec2>& v, double& mag) {
     double E = 0.0;
     mag = 0.0;
     for (std::size_t q = 0; q < M; ++q) {
       if (!(s.inv[q] > 0.0)) continue;
-      const double ke = 0.5 * length_squared(v[q]) / s.inv[q], pe = -dot(s.a[q], x[q]) / s.inv[q];
-      E += ke + pe;
-      mag += ke + std::fabs(pe);
+      const double ke = 0.5 * length_squared(v[q]) / s.inv[q], pe = -dot(s.field[q], x[q]) / s.inv[q];
+      const double other = -dot(s.a[q] - s.field[q], x[q] - s.x0[q]) / s.inv[q];
+      E += ke + pe + other;
+      mag += ke + std::fabs(pe) + std::fabs(other);
     }
     return E;
   };
@@ -759,6 +768,9 @@ bool holds_at_rest(World& w, Group& g, Scratch& s, double h, double dt) {
       c.pn = it->pn * h / g.warm_h;
       c.pt = it->pt * h / g.warm_h;
     }
+  }
+  if (w.varying_forces) {   // the forces on bodies at rest
+    for (std::size_t q = 0; q < M; ++q) s.a[q] = body_acceleration(w, g.members[q], Vec2{});
   }
   for (std::size_t q = 0; q < M; ++q) s.v[q] = h * s.a[q];
   apply_ordered(s, s.cons, [](const Con& c) { return c.pn * c.n + c.pt * perp(c.n); });
@@ -943,18 +955,21 @@ void note_storm_impact(World& w, std::uint32_t i, std::uint32_t j) {
   if (w.storm_count.size() != w.size()) w.storm_count.resize(w.size(), 0);
   for (std::uint32_t x : {i, j}) {
     if (w.storm_count[x]++ == 0) w.storm_bodies.push_back(x);
+    if (w.storm_count[x] > kStormBail) w.storm_bail = true;
   }
 }
 
-void engage_storm_groups(World& w, const StepContext& ctx) {
-  if (w.storm_bodies.empty()) return;
+static bool engage_storms(World& w, const StepContext& ctx, double t, bool now) {
+  if (w.storm_bodies.empty()) return false;
+  const double reach_dt = ctx.dt - t;   // what is left of the step (the next step's at its end)
+  bool made = false;
   std::vector<std::uint32_t> hot;
   for (std::uint32_t x : w.storm_bodies) {
     if (w.storm_count[x] > kStormImpacts) hot.push_back(x);
     w.storm_count[x] = 0;
   }
   w.storm_bodies.clear();
-  if (hot.empty() || !contact_groups_allowed(w) || !w.granular_enabled || w.group_disturbed != kNone) return;
+  if (hot.empty() || !granular_allowed(w) || w.group_disturbed != kNone) return false;
   std::sort(hot.begin(), hot.end());
   std::vector<char> taken(w.size(), 0);
   for (const Group& g : w.contact_groups) {
@@ -965,7 +980,9 @@ void engage_storm_groups(World& w, const StepContext& ctx) {
     if ((w.flags[seed] & (kPoint | kParticle | kDestroyOnHit)) != 0 || w.riding(seed) || seed >= w.scene_bodies) continue;
     std::vector<std::uint32_t> members{seed}, add;
     std::vector<std::size_t> merge;
-    if (!plan_group_reach(w, members, ctx.dt, static_cast<std::size_t>(-1), -1, add, merge, true)) continue;
+    if (!plan_group_reach(w, members, now ? reach_dt : ctx.dt, static_cast<std::size_t>(-1), -1, add, merge, true)) continue;
+    // (engaged now: a group already stepping in this step cannot take it; the storm goes on)
+    if (now && !merge.empty()) continue;
     members.insert(members.end(), add.begin(), add.end());
     // groups it reaches: their members join this one
     std::sort(merge.begin(), merge.end());
@@ -1012,9 +1029,27 @@ void engage_storm_groups(World& w, const StepContext& ctx) {
       g.members.push_back(m);
       g.acc.push_back(group_force_acc(w, m));
     }
-    if (w.group_first_time < 0.0) w.group_first_time = w.time;
+    if (w.group_first_time < 0.0) w.group_first_time = w.time + (now ? t : 0.0);
+    if (now) {   // hidden from the rest of the step, stepped from t
+      g.start = t;
+      if (w.group_p0.size() != w.size()) {
+        w.group_p0 = w.pos;
+        w.group_v0 = w.vel;
+      }
+      for (std::uint32_t m : g.members) {
+        w.group_p0[m] = w.pos[m];
+        w.group_v0[m] = w.vel[m];
+        w.flags[m] = static_cast<std::uint8_t>(w.flags[m] & ~kAlive);
+      }
+    }
     w.contact_groups.push_back(std::move(g));
+    made = true;
   }
+  return made;
 }
+
+void engage_storm_groups(World& w, const StepContext& ctx) { engage_storms(w, ctx, 0.0, false); }
+
+bool engage_storm_groups_now(World& w, const StepContext& ctx, double t) { return engage_storms(w, ctx, t, true); }
 
 }  // namespace physval::core_detail

@@ -307,6 +307,7 @@ struct World {
     bool sleeping = false;   // granular, at rest and held by its contacts: not stepped
     std::vector<GranularWarm> warm;   // sorted by key
     double warm_h = 0.0;              // the sub-step the warm impulses were found at
+    double start = 0.0;               // engaged inside the current step: steps from here (s)
   };
   std::vector<ContactGroup> contact_groups;
   double group_dt = 0.0;
@@ -325,6 +326,7 @@ struct World {
   double granular_first_time = -1.0, granular_worst_residual = 0.0;
   std::vector<std::uint32_t> storm_count;   // per body, this step; empty when unused
   std::vector<std::uint32_t> storm_bodies;  // bodies with a count to reset
+  bool storm_bail = false;   // a count passed kStormBail in this step: engaged at once
   bool granular_enabled = true;   // [core] dense_contact = "granular" (default) or "events"
 
   // ---- convex corners (convex_cap.cpp): bodies riding a segment end's cap, the circle of
@@ -756,6 +758,10 @@ inline Vec2 group_force_acc(const World& w, std::uint32_t i) {
 // Whether the scene allows contact groups at all (exact impacts, constant forces, no rules,
 // emitters or Newtonian gravity).
 bool contact_groups_allowed(const World& w);
+// Whether it allows granular groups (granular.cpp): the same but forces may depend on the
+// velocity (drag, wind, thrust, taken at each sub-step's start), and not with
+// [core] dense_contact = "events".
+bool granular_allowed(const World& w);
 
 // Granular groups (granular.cpp): nonsmooth contact dynamics (Moreau-Jean time stepping) on
 // sub-steps, the velocity-level Signorini-Coulomb problem solved by projected Gauss-Seidel to
@@ -770,8 +776,14 @@ void granular_split(World& w, World::ContactGroup& g, double dt, std::vector<Wor
 // impacts (the inelastic collapse of a pile) makes the bodies touching it, transitively, a
 // granular group at the step's end (where groups are allowed).
 inline constexpr std::uint32_t kStormImpacts = 24;
+// A storm this fierce within one step (a collapse that would run to the event cap) is engaged
+// at once, for the rest of the step (engage_storm_groups_now, from the event loop).
+inline constexpr std::uint32_t kStormBail = 8 * kStormImpacts;
 void note_storm_impact(World& w, std::uint32_t i, std::uint32_t j);
 void engage_storm_groups(World& w, const StepContext& ctx);
+// The same at time t within the step (every body advanced to t): the new groups are hidden and
+// step from t (ContactGroup::start). True if a group was made.
+bool engage_storm_groups_now(World& w, const StepContext& ctx, double t);
 // The bodies that may meet a group (members `members`) within a step of dt, transitively:
 // appended to `add`; groups within reach to `merge` (indices into w.contact_groups). False
 // where one cannot join (a particle or point, a body on a corner's cap, or, when `limit` is
