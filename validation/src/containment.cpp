@@ -10,7 +10,13 @@ namespace physval {
 namespace {
 
 constexpr std::size_t kBruteForceBarriers = 16;
-constexpr std::size_t kMinStripBodies = 32;   // fewer: the plain sweep
+// Fewer moving bodies: the plain sweep. Its x windows hold about 10 bodies in circle_gas
+// (200), and the strips' own passes cost more than they save below about a thousand
+// (BM_ContainmentCircleGasRun 4.0-4.25 against 4.15-5.3 ms for core's run, 4.35-4.7
+// against 4.9-6.0 ms for Box2D's; BM_ContainmentObserveGas 1000/220 85-91 against
+// 86-101 us, alternated, load 3-4).
+constexpr std::size_t kMinStripBodies = 1024;
+constexpr std::size_t kMinForcedStripBodies = 32;
 constexpr double kMaxCellsPerBarrier = 4096.0;
 
 std::int64_t cell_index(double x, double inv) {
@@ -404,7 +410,7 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
   // body then scans its own strip and the two beside it, where the whole sweep scanned
   // every body in its x range (in a 1k-body gas about 17, of which one or two pass).
   std::uint32_t strips = 0;
-  bool use_strips = !plain_sweep_ && n >= kMinStripBodies;
+  bool use_strips = !plain_sweep_ && n >= (force_strips_ ? kMinForcedStripBodies : kMinStripBodies);
   if (use_strips) {
     double ymin = std::numeric_limits<double>::infinity(), ymax = -ymin, swept = 0.0;
     bool clean = true;
