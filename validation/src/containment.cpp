@@ -11,11 +11,10 @@ namespace {
 
 constexpr std::size_t kBruteForceBarriers = 16;
 // Fewer moving bodies: the plain sweep. Its x windows hold about 10 bodies in circle_gas
-// (200), and the strips' own passes cost more than they save below about a thousand
-// (BM_ContainmentCircleGasRun 4.0-4.25 against 4.15-5.3 ms for core's run, 4.35-4.7
-// against 4.9-6.0 ms for Box2D's; BM_ContainmentObserveGas 1000/220 85-91 against
-// 86-101 us, alternated, load 3-4).
-constexpr std::size_t kMinStripBodies = 1024;
+// (200), where the strips' own passes cost more than they save (BM_ContainmentCircleGasRun
+// 4.1-4.7 against 4.8-5.2 ms for core's run, 4.5-5.2 against 5.0-5.7 ms for Box2D's,
+// alternated, load 3-9); at 1,000 (BM_ContainmentObserveGas/1000) neither wins clearly.
+constexpr std::size_t kMinStripBodies = 512;
 constexpr std::size_t kMinForcedStripBodies = 32;
 constexpr double kMaxCellsPerBarrier = 4096.0;
 

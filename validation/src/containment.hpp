@@ -48,7 +48,7 @@ class ContainmentMonitor {
   void set_object_names(std::function<std::string(std::size_t)> name_of) { name_of_ = std::move(name_of); }
 
   // Tests and benchmarks only: the moving pairs by the plain x sweep, never through
-  // horizontal strips, or through the strips from 32 bodies on, whatever the count (both
+  // horizontal strips, or through the strips from 32 bodies on (by default from 512) (both
   // must find the same pairs in the same order: test Containment.StripsEqualPlainSweep*).
   void use_plain_sweep(bool plain) { plain_sweep_ = plain; }
   void use_strips(bool strips) { force_strips_ = strips; }
