@@ -63,8 +63,8 @@ SeriesDivergence series_divergence(const Series& run, const Series& ref, double 
   // and agree again at the next paired sample) is left out of the energy and momentum
   // comparison; a destruction that really differs still differs at the next sample.
   auto same_alive = [&](std::size_t k) {
-    const SampleRow& sa = run.states[k];
-    const SampleRow& sb = ref.states[static_cast<std::size_t>(pairs[k])];
+    const SampleRows::ConstRow sa = run.states[k];
+    const SampleRows::ConstRow sb = ref.states[static_cast<std::size_t>(pairs[k])];
     if (sa.size() != sb.size()) return false;
     for (std::size_t i = 0; i < sa.size(); ++i) {
       if (sa[i].alive != sb[i].alive) return false;
@@ -76,8 +76,8 @@ SeriesDivergence series_divergence(const Series& run, const Series& ref, double 
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     if (pairs[k] < 0) continue;
     const auto j = static_cast<std::size_t>(pairs[k]);
-    const SampleRow& sa = run.states[k];
-    const SampleRow& sb = ref.states[j];
+    const SampleRows::ConstRow sa = run.states[k];
+    const SampleRows::ConstRow sb = ref.states[j];
     const std::size_t bodies = std::min({sa.size(), sb.size(), scene_bodies});
     for (std::size_t i = 0; i < bodies; ++i) {
       if (!sa[i].alive || !sb[i].alive) continue;
@@ -583,8 +583,8 @@ void judge_against_own_reference(RunRecord& run, const Scene& scene, const Refer
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     if (pairs[k] < 0) continue;
     ++paired;
-    const SampleRow& sa = run.series.states[k];
-    const SampleRow& sb = ref.states[static_cast<std::size_t>(pairs[k])];
+    const SampleRows::ConstRow sa = run.series.states[k];
+    const SampleRows::ConstRow sb = ref.states[static_cast<std::size_t>(pairs[k])];
     for (std::size_t i = 0; i < std::min({sa.size(), sb.size(), limits.size()}); ++i) {
       if (!sa[i].alive || !sb[i].alive) continue;
       const double error = length(sa[i].position - sb[i].position);

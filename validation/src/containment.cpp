@@ -10,7 +10,12 @@ namespace physval {
 namespace {
 
 constexpr std::size_t kBruteForceBarriers = 16;
-constexpr std::size_t kMinStripBodies = 32;   // fewer: the plain sweep
+// Fewer moving bodies: the plain sweep. Its x windows hold about 10 bodies in circle_gas
+// (200), where the strips' own passes cost more than they save (BM_ContainmentCircleGasRun
+// 4.1-4.7 against 4.8-5.2 ms for core's run, 4.5-5.2 against 5.0-5.7 ms for Box2D's,
+// alternated, load 3-9); at 1,000 (BM_ContainmentObserveGas/1000) neither wins clearly.
+constexpr std::size_t kMinStripBodies = 512;
+constexpr std::size_t kMinForcedStripBodies = 32;
 constexpr double kMaxCellsPerBarrier = 4096.0;
 
 std::int64_t cell_index(double x, double inv) {
@@ -404,7 +409,7 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
   // body then scans its own strip and the two beside it, where the whole sweep scanned
   // every body in its x range (in a 1k-body gas about 17, of which one or two pass).
   std::uint32_t strips = 0;
-  bool use_strips = !plain_sweep_ && n >= kMinStripBodies;
+  bool use_strips = !plain_sweep_ && n >= (force_strips_ ? kMinForcedStripBodies : kMinStripBodies);
   if (use_strips) {
     double ymin = std::numeric_limits<double>::infinity(), ymax = -ymin, swept = 0.0;
     bool clean = true;

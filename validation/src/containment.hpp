@@ -47,9 +47,11 @@ class ContainmentMonitor {
   // no emitter owns), a particle is taken as the first emitter's.
   void set_object_names(std::function<std::string(std::size_t)> name_of) { name_of_ = std::move(name_of); }
 
-  // Tests only: the moving pairs by the plain x sweep, never through horizontal strips
-  // (both must find the same pairs in the same order: test Containment.StripsEqualPlainSweep*).
+  // Tests and benchmarks only: the moving pairs by the plain x sweep, never through
+  // horizontal strips, or through the strips from 32 bodies on (by default from 512) (both
+  // must find the same pairs in the same order: test Containment.StripsEqualPlainSweep*).
   void use_plain_sweep(bool plain) { plain_sweep_ = plain; }
+  void use_strips(bool strips) { force_strips_ = strips; }
   // Tests only: every moving pair the filters pass goes through the full tests, none is left
   // out as apart all step (both must give the same record: test Containment.FarPairSkip*);
   // and how many were left out.
@@ -113,6 +115,7 @@ class ContainmentMonitor {
   // bodies' positions in x order, their left ends and y intervals, and a cursor past those
   // already swept; strip_of_ per x-order position.
   bool plain_sweep_ = false;
+  bool force_strips_ = false;
   bool full_pair_tests_ = false;
   std::uint64_t far_pairs_skipped_ = 0;
   std::vector<std::uint32_t> strip_of_, strip_start_, strip_cursor_, strip_item_;

@@ -471,25 +471,34 @@ class JsonStream {
     const std::string to_step = line(",\n", pad + 2, "\"step\": ");
     const std::string to_time = line(",\n", pad + 2, "\"time\": ");
     const std::string close = line("\n", pad, "}");
+    // Each contact's text is put at a cursor into text_, made large enough for the contact
+    // first (its fixed pieces, its names and a time and step of at most 64 characters each,
+    // or the names' escaped text), then cut to what was written before a flush.
     std::string& t = text_;
-    t.clear();
-    t += "[\n";
+    t.assign("[\n");
+    std::size_t used = t.size();
+    const std::size_t fixed = open.size() + after_a.size() + to_step.size() + to_time.size() + close.size() + 2 + 64 + 24;
+    auto put = [&](const std::string& piece) {
+      std::memcpy(t.data() + used, piece.data(), piece.size());
+      used += piece.size();
+    };
     char time_text[64];
     std::size_t time_text_size = 0;
     double last_time = 0.0;
     bool have_time = false;
     for (std::size_t k = 0; k < cs.size(); ++k) {
       const ContactRecord& c = cs[k];
-      t += open;
-      put_string(c.a);
-      t += after_a;
-      put_string(c.b);
+      const std::size_t room = fixed + 2 * (c.a.size() + c.b.size()) + 4;
+      if (used + room > t.size()) t.resize(std::max(used + room, 2 * t.size()));
+      put(open);
+      put_string_at(t, used, c.a);
+      put(after_a);
+      put_string_at(t, used, c.b);
       if (with_step) {
-        t += to_step;
-        char buf[24];
-        t.append(buf, std::to_chars(buf, buf + sizeof buf, static_cast<std::int64_t>(c.step)).ptr);
+        put(to_step);
+        used = static_cast<std::size_t>(std::to_chars(t.data() + used, t.data() + used + 24, static_cast<std::int64_t>(c.step)).ptr - t.data());
       }
-      t += to_time;
+      put(to_time);
       if (std::isfinite(c.time)) {
         // A run's contacts come in time order, many in one step at the same time (every
         // contact a step-end engine reports in a step): the text of the time before is
@@ -499,17 +508,21 @@ class JsonStream {
           last_time = c.time;
           have_time = true;
         }
-        t.append(time_text, time_text_size);
+        std::memcpy(t.data() + used, time_text, time_text_size);
+        used += time_text_size;
       } else {
-        t += "null";
+        std::memcpy(t.data() + used, "null", 4);
+        used += 4;
       }
-      t += close;
-      t += k + 1 < cs.size() ? ",\n" : "\n";
-      if (t.size() >= (std::size_t{1} << 16)) {
-        os_.write(t.data(), static_cast<std::streamsize>(t.size()));
-        t.clear();
+      put(close);
+      std::memcpy(t.data() + used, k + 1 < cs.size() ? ",\n" : "\n", k + 1 < cs.size() ? 2 : 1);
+      used += k + 1 < cs.size() ? 2 : 1;
+      if (used >= (std::size_t{1} << 16)) {
+        os_.write(t.data(), static_cast<std::streamsize>(used));
+        used = 0;
       }
     }
+    t.resize(used);
     t.append(static_cast<std::size_t>(2 * depth), ' ');
     t += ']';
     os_.write(t.data(), static_cast<std::streamsize>(t.size()));
@@ -540,19 +553,24 @@ class JsonStream {
   }
 
  private:
-  // A JSON string as nlohmann's dump writes it: plain printable ASCII as it is, anything
-  // else (escapes, UTF-8) by nlohmann itself.
-  void put_string(const std::string& v) {
+  // A JSON string as nlohmann's dump writes it, at t[used], where room for twice the
+  // name's size and its quotes was made: plain printable ASCII as it is, anything else
+  // (escapes, UTF-8) by nlohmann itself (rare: t grows by its text).
+  static void put_string_at(std::string& t, std::size_t& used, const std::string& v) {
     for (const char ch : v) {
       const auto u = static_cast<unsigned char>(ch);
       if (u < 0x20 || u >= 0x7f || ch == '"' || ch == '\\') {
-        text_ += json(v).dump();
+        const std::string text = json(v).dump();
+        t.resize(t.size() + text.size());   // the room made for the contact's other pieces is kept
+        std::memcpy(t.data() + used, text.data(), text.size());
+        used += text.size();
         return;
       }
     }
-    text_ += '"';
-    text_ += v;
-    text_ += '"';
+    t[used++] = '"';
+    std::memcpy(t.data() + used, v.data(), v.size());
+    used += v.size();
+    t[used++] = '"';
   }
 
   std::ostream& os_;

@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
+#include <type_traits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -25,6 +27,8 @@ class Writer {
  public:
   explicit Writer(Sink& sink) : sink_(sink) {}
   void raw(const void* p, std::size_t n) { sink_.put(p, n); }
+  // A long run of bytes (a series' block): straight from where it lies.
+  void large(const void* p, std::size_t n) { sink_.put_large(p, n); }
   void u64(std::uint64_t v) { raw(&v, sizeof v); }
   void i64(std::int64_t v) { raw(&v, sizeof v); }
   void f64(double v) { raw(&v, sizeof v); }
@@ -102,33 +106,26 @@ void write_record(Sink& sink, const RunRecord& r) {
     w.f64(p.last_full_rev_time);
     w.i64(p.full_revolutions);
   }
-  w.u64(r.series.time.size());
-  for (std::size_t k = 0; k < r.series.time.size(); ++k) {
-    w.f64(r.series.time[k]);
-    const Totals& t = k < r.series.totals.size() ? r.series.totals[k] : Totals{};
-    w.f64(t.kinetic);
-    w.f64(t.potential);
-    w.f64(t.momentum.x);
-    w.f64(t.momentum.y);
-    w.f64(t.angular_momentum);
-    static const SampleRow none;
-    const SampleRow& st = k < r.series.states.size() ? r.series.states[k] : none;
-    w.u64(st.size());
-    // The row's samples encoded in blocks (one put per block, not three per body).
-    constexpr std::size_t kBlock = 256, kSampleBytes = 2 * sizeof(double) + 1;
-    std::uint8_t block[kBlock * kSampleBytes];
-    for (std::size_t i = 0; i < st.size(); i += kBlock) {
-      const std::size_t n = std::min(kBlock, st.size() - i);
-      std::uint8_t* o = block;
-      for (std::size_t m = 0; m < n; ++m, o += kSampleBytes) {
-        const SampleState& s = st[i + m];
-        std::memcpy(o, &s.position.x, sizeof(double));
-        std::memcpy(o + sizeof(double), &s.position.y, sizeof(double));
-        o[2 * sizeof(double)] = s.alive ? 1 : 0;
-      }
-      w.raw(block, n * kSampleBytes);
+  // The series as four blocks: the times, the totals, the rows' sizes and the rows' states
+  // (the states' bytes as they lie in memory: read back into place, no decoding).
+  const std::size_t ns = r.series.time.size();
+  w.u64(ns);
+  w.large(r.series.time.data(), ns * sizeof(double));
+  if (r.series.totals.size() >= ns) {
+    w.large(r.series.totals.data(), ns * sizeof(Totals));
+  } else {
+    for (std::size_t k = 0; k < ns; ++k) {
+      const Totals t = k < r.series.totals.size() ? r.series.totals[k] : Totals{};
+      w.raw(&t, sizeof t);
     }
   }
+  const std::size_t rows = std::min(ns, r.series.states.size());
+  {
+    std::vector<std::uint64_t> sizes(ns, 0);
+    for (std::size_t k = 0; k < rows; ++k) sizes[k] = r.series.states.row_start(k + 1) - r.series.states.row_start(k);
+    w.large(sizes.data(), ns * sizeof(std::uint64_t));
+  }
+  w.large(r.series.states.data(), r.series.states.row_start(rows) * sizeof(SampleState));
   w.u64(r.final_states.size());
   for (const BodyState& s : r.final_states) w.state(s);
   const ContainmentRecord& c = r.containment;
@@ -161,6 +158,7 @@ struct VectorSink {
     const auto* c = static_cast<const std::uint8_t*>(p);
     out.insert(out.end(), c, c + n);
   }
+  void put_large(const void* p, std::size_t n) { put(p, n); }
 };
 
 struct FdSink {
@@ -196,6 +194,25 @@ struct FdSink {
       n -= k;
     }
   }
+  // Past the buffer: what it holds first, then the bytes straight from where they lie.
+  void put_large(const void* p, std::size_t n) {
+    if (n <= kSize - used) {
+      put(p, n);
+      return;
+    }
+    flush();
+    const auto* c = static_cast<const std::uint8_t*>(p);
+    while (ok && n > 0) {
+      const ssize_t w = ::write(fd, c, n);
+      if (w < 0) {
+        if (errno == EINTR) continue;
+        ok = false;
+        break;
+      }
+      c += w;
+      n -= static_cast<std::size_t>(w);
+    }
+  }
 };
 
 // --- reading -----------------------------------------------------------------------
@@ -215,6 +232,7 @@ struct VectorSource {
     at += n;
     return p;
   }
+  void get_large(void* p, std::size_t n) { get(p, n); }
 };
 
 struct FdSource {
@@ -223,7 +241,8 @@ struct FdSource {
   static constexpr std::size_t kSize = std::size_t{1} << 18;
   std::unique_ptr<std::uint8_t[]> buffer = std::make_unique_for_overwrite<std::uint8_t[]>(kSize);   // not zeroed
   std::size_t begin = 0, end = 0, total = 0;
-  void fill() {
+  // Until the pipe has bytes (or the deadline passes: RecordTimeout).
+  void wait_readable() {
     for (;;) {
       int wait_ms = -1;
       if (deadline) {
@@ -235,14 +254,23 @@ struct FdSource {
       const int ready = ::poll(&p, 1, wait_ms);
       if (ready < 0 && errno == EINTR) continue;
       if (ready == 0) continue;   // re-checks the deadline
-      const ssize_t got = ::read(fd, buffer.get(), kSize);
-      if (got < 0 && errno == EINTR) continue;
-      if (got <= 0) throw std::runtime_error("run record: the stream ended early");
-      begin = 0;
-      end = static_cast<std::size_t>(got);
-      total += end;
       return;
     }
+  }
+  // Up to n bytes into p, at least one.
+  std::size_t read_some(void* p, std::size_t n) {
+    for (;;) {
+      wait_readable();
+      const ssize_t got = ::read(fd, p, n);
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0) throw std::runtime_error("run record: the stream ended early");
+      total += static_cast<std::size_t>(got);
+      return static_cast<std::size_t>(got);
+    }
+  }
+  void fill() {
+    begin = 0;
+    end = read_some(buffer.get(), kSize);
   }
   void get(void* p, std::size_t n) {
     auto* c = static_cast<std::uint8_t*>(p);
@@ -261,6 +289,20 @@ struct FdSource {
     const char* p = reinterpret_cast<const char*>(buffer.get() + begin);
     begin += n;
     return p;
+  }
+  // A long run of bytes: what the buffer holds, then read from the pipe straight into p.
+  void get_large(void* p, std::size_t n) {
+    auto* c = static_cast<std::uint8_t*>(p);
+    const std::size_t k = std::min(n, end - begin);
+    std::memcpy(c, buffer.get() + begin, k);
+    begin += k;
+    c += k;
+    n -= k;
+    while (n > 0) {
+      const std::size_t got = read_some(c, n);
+      c += got;
+      n -= got;
+    }
   }
 };
 
@@ -324,6 +366,7 @@ class Reader {
     return s;
   }
   void raw(void* p, std::size_t n) { src_.get(p, n); }
+  void large(void* p, std::size_t n) { src_.get_large(p, n); }
 
  private:
   Source& src_;
@@ -394,39 +437,55 @@ RunRecord read_record(Source& source) {
     p.full_revolutions = static_cast<int>(rd.i64());
     r.probes.push_back(std::move(p));
   }
+  // The series: its four blocks (write_record), each read straight into place. A corrupt
+  // count cannot allocate much more than arrives: blocks are made in pieces of at most
+  // kPiece elements as their bytes come, past the first.
   const std::uint64_t ns = rd.count();
-  reserve_some(r.series.time, ns);
-  reserve_some(r.series.totals, ns);
-  reserve_some(r.series.states, ns);
-  for (std::uint64_t k = 0; k < ns; ++k) {
-    r.series.time.push_back(rd.f64());
-    Totals t;
-    t.kinetic = rd.f64();
-    t.potential = rd.f64();
-    t.momentum.x = rd.f64();
-    t.momentum.y = rd.f64();
-    t.angular_momentum = rd.f64();
-    r.series.totals.push_back(t);
-    const std::uint64_t n = rd.count();
-    SampleRow st;
-    reserve_some(st, n);
-    // Read in blocks, as written (a corrupt count fails on reading, not allocating).
-    constexpr std::size_t kBlock = 256, kSampleBytes = 2 * sizeof(double) + 1;
-    std::uint8_t block[kBlock * kSampleBytes];
-    for (std::uint64_t i = 0; i < n; i += kBlock) {
-      const auto m = static_cast<std::size_t>(std::min<std::uint64_t>(kBlock, n - i));
-      rd.raw(block, m * kSampleBytes);
-      for (std::size_t q = 0; q < m; ++q) {
-        const std::uint8_t* c = block + q * kSampleBytes;
-        SampleState x;
-        std::memcpy(&x.position.x, c, sizeof(double));
-        std::memcpy(&x.position.y, c + sizeof(double), sizeof(double));
-        if (c[2 * sizeof(double)] > 1) throw std::runtime_error("run record: malformed (flag)");
-        x.alive = c[2 * sizeof(double)] == 1;
-        st.push_back(x);
+  constexpr std::uint64_t kPiece = 1u << 20;
+  auto read_block = [&](auto& v, std::uint64_t n) {
+    using T = typename std::remove_reference_t<decltype(v)>::value_type;
+    for (std::uint64_t done = 0; done < n;) {
+      const auto m = static_cast<std::size_t>(std::min(kPiece, n - done));
+      v.resize(static_cast<std::size_t>(done) + m);
+      rd.large(v.data() + done, m * sizeof(T));
+      done += m;
+    }
+  };
+  read_block(r.series.time, ns);
+  static_assert(std::is_trivially_copyable_v<Totals> && sizeof(Totals) == 5 * sizeof(double));
+  read_block(r.series.totals, ns);
+  std::vector<std::uint64_t> sizes64;
+  read_block(sizes64, ns);
+  std::uint64_t samples = 0;
+  std::vector<std::size_t> sizes(sizes64.size());
+  for (std::size_t k = 0; k < sizes64.size(); ++k) {
+    if (sizes64[k] > kMaxCount || (samples += sizes64[k]) > kMaxCount) {
+      throw std::runtime_error("run record: malformed (series of " + std::to_string(sizes64[k]) + " states a row)");
+    }
+    sizes[k] = static_cast<std::size_t>(sizes64[k]);
+  }
+  auto check_flags = [](const SampleState* p, std::size_t n) {
+    const auto* bytes = reinterpret_cast<const std::uint8_t*>(p);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (bytes[i * sizeof(SampleState) + offsetof(SampleState, alive)] > 1) throw std::runtime_error("run record: malformed (flag)");
+    }
+  };
+  if (samples <= 4 * kPiece) {
+    SampleState* out = r.series.states.append_uninitialised(sizes);
+    rd.large(out, static_cast<std::size_t>(samples) * sizeof(SampleState));
+    check_flags(out, static_cast<std::size_t>(samples));
+  } else {
+    // Row by row (each in pieces): a corrupt size fails on reading, not allocating.
+    for (const std::size_t n : sizes) {
+      r.series.states.append_uninitialised({0});
+      for (std::size_t done = 0; done < n;) {
+        const std::size_t m = std::min<std::size_t>(kPiece, n - done);
+        SampleState* out = r.series.states.extend_last_row_uninitialised(m);
+        rd.large(out, m * sizeof(SampleState));
+        check_flags(out, m);
+        done += m;
       }
     }
-    r.series.states.push_back(std::move(st));
   }
   const std::uint64_t nf = rd.count();
   reserve_some(r.final_states, nf);

@@ -323,6 +323,14 @@ RunRecord run_engine(const Scene& scene, const EngineFactory& factory, const Run
     ContainmentMonitor containment(scene);
     containment.set_object_names([&engine](std::size_t i) { return engine->body_meta(i).name; });
     const long n = scene.steps();
+    // The series' block made once for the samples planned (one every `every` steps, the
+    // start and the last step's): rows grow it only when particles appear.
+    {
+      const auto rows = static_cast<std::size_t>(n / every) + 2;
+      r.series.time.reserve(rows);
+      r.series.totals.reserve(rows);
+      r.series.states.reserve(rows, rows * engine->body_count());
+    }
     if (!sample(0.0)) {
       r.status = RunStatus::Diverged;
       r.reason = "the initial state is not finite (a position or velocity, or the energy or momentum made of them)";

@@ -338,7 +338,7 @@ TEST(Containment, RealEnginesInAClosedBoxAtManySteps) {
 }
 
 
-// The moving pairs through horizontal strips (the monitor's default from 32 moving bodies)
+// The moving pairs through horizontal strips (the monitor's default from 512 moving bodies)
 // against the plain x sweep: the same record after every step (deepest overlap, its time
 // and pair, escapes, the first escape's names) on gases where pairs overlap, tie exactly
 // (a lattice), pass into each other (jumps), die and come back, with mixed radii, points,
@@ -381,6 +381,7 @@ TEST(Containment, StripsEqualPlainSweepOnRandomGases) {
     }
     scene.collision_matrix.push_back({"ghost", "", CollisionResponse::Ignore});
     ContainmentMonitor strips(scene), plain(scene);
+    strips.use_strips(true);   // from 32 bodies (by default from 512)
     plain.use_plain_sweep(true);
     auto same = [&](int k) {
       const ContainmentRecord& a = strips.record();

@@ -60,7 +60,7 @@ TEST(Hunt3, ASmallBallWhollyInsideALargeOneIsAnEscape) {
           compare_run(run, s, Reference{}, false);
           ++runs;
           double closest = 1e300;
-          for (const SampleRow& row : run.series.states) closest = std::min(closest, length(row[0].position - row[1].position));
+          for (const auto row : run.series.states) closest = std::min(closest, length(row[0].position - row[1].position));
           const bool beyond = run.final_states[0].position.x > run.final_states[1].position.x + 1.0;
           const std::string what = f.info.name + " r " + std::to_string(r) + " v " + std::to_string(speed) + " off " +
                                    std::to_string(offset) + ": closest " + std::to_string(closest);

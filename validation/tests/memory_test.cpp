@@ -11,11 +11,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <thread>
 
 #include "physval/validation/results_json.hpp"
 #include "physval/validation/run_record_io.hpp"
@@ -158,6 +161,77 @@ TEST(Memory, RunRecordSurvivesTheByteStream) {
                  std::runtime_error)
         << cut;
   }
+}
+
+// The series crosses as blocks read into place (run_record_io.cpp): rows of different sizes
+// (particles appear), through a pipe whose writer and reader meet it in pieces, and past
+// the size read at once (4M states), row by row; an alive flag that is no bool is refused.
+TEST(Memory, SeriesBlocksSurviveThePipeInPlace) {
+  auto record = [](std::size_t rows, std::size_t first, std::size_t growth) {
+    physval::RunRecord r;
+    r.scenario = "s";
+    r.engine = "core";
+    for (std::size_t k = 0; k < rows; ++k) {
+      r.series.time.push_back(0.1 * static_cast<double>(k));
+      physval::Totals t;
+      t.kinetic = static_cast<double>(k);
+      t.angular_momentum = -static_cast<double>(k);
+      r.series.totals.push_back(t);
+      physval::SampleRow row(first + k * growth);
+      for (std::size_t i = 0; i < row.size(); ++i) row[i] = {{static_cast<double>(k), static_cast<double>(i)}, (i + k) % 3 != 0};
+      r.series.states.push_back(row);
+    }
+    return r;
+  };
+  auto same = [](const physval::RunRecord& a, const physval::RunRecord& b) {
+    ASSERT_EQ(a.series.time, b.series.time);
+    ASSERT_EQ(a.series.states.size(), b.series.states.size());
+    for (std::size_t k = 0; k < a.series.states.size(); ++k) {
+      EXPECT_EQ(a.series.totals[k].kinetic, b.series.totals[k].kinetic);
+      EXPECT_EQ(a.series.totals[k].angular_momentum, b.series.totals[k].angular_momentum);
+      const auto x = a.series.states[k], y = b.series.states[k];
+      ASSERT_EQ(x.size(), y.size()) << k;
+      for (std::size_t i = 0; i < x.size(); ++i) {
+        ASSERT_EQ(x[i].position.x, y[i].position.x);
+        ASSERT_EQ(x[i].position.y, y[i].position.y);
+        ASSERT_EQ(x[i].alive, y[i].alive);
+      }
+    }
+  };
+  // Through a pipe, written by another thread: 50 rows of 2,000 to 2,049 states, 2.4 MB.
+  const physval::RunRecord piped = record(50, 2000, 1);
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  std::thread writer([&] {
+    EXPECT_TRUE(physval::write_run_record(fds[1], piped));
+    ::close(fds[1]);
+  });
+  std::size_t bytes = 0;
+  const physval::RunRecord back = physval::read_run_record(fds[0], std::nullopt, bytes);
+  writer.join();
+  ::close(fds[0]);
+  EXPECT_GT(bytes, 50u * 2000u * sizeof(physval::SampleState));
+  same(piped, back);
+  // Past 4M states: read row by row (5 rows of 900,000 states).
+  const physval::RunRecord big = record(5, 900000, 0);
+  same(big, physval::decode_run_record(physval::encode_run_record(big)));
+  // An alive flag of 2 in the block is refused.
+  std::vector<std::uint8_t> damaged = physval::encode_run_record(record(3, 10, 2));
+  // The last state's flag: right after its position (2, 13), the last such pair of doubles.
+  const double last[2] = {2.0, 13.0};
+  const auto* pattern = reinterpret_cast<const std::uint8_t*>(last);
+  const auto at = std::find_end(damaged.begin(), damaged.end(), pattern, pattern + sizeof last);
+  ASSERT_NE(at, damaged.end());
+  const std::size_t flag = static_cast<std::size_t>(at - damaged.begin()) + sizeof last;
+  ASSERT_EQ(damaged[flag], 0);   // (13 + 2) % 3 == 0: not alive
+  bool refused = false;
+  damaged[flag] = 2;
+  try {
+    (void)physval::decode_run_record(damaged);
+  } catch (const std::runtime_error& e) {
+    refused = std::string(e.what()).find("flag") != std::string::npos;
+  }
+  EXPECT_TRUE(refused);
 }
 
 }  // namespace

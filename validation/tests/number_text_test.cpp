@@ -96,11 +96,16 @@ TEST(NumberText, StreamedContactsAreTheTreesDumpForOddNamesAndTimes) {
   r.scenario = "odd";
   r.engine = "core";
   const double inf = std::numeric_limits<double>::infinity();
-  const std::string names[] = {"plain", "quote\"d", "back\\slash", "tab\there", "caf\xc3\xa9", "del\x7f", "", "c0"};
+  // A long name of escapes (6 characters each: more than the room made for a name's text)
+  // and enough contacts (about 350 kB) for the text to be flushed and grown several times.
+  const std::string names[] = {"plain", "quote\"d", "back\\slash", "tab\there", "caf\xc3\xa9", "del\x7f", "",
+                               std::string(40, '\x01')};
   const double times[] = {0.0, -0.0, 1.0, 0.1, 1e-300, 123456789.123, -2.5, inf, -inf, std::nan(""), 1.0 / 3.0};
   long step = -3;
-  for (const std::string& a : names) {
-    for (const double t : times) r.contacts.push_back({a, names[static_cast<std::size_t>(step + 3) % 8], t, step++});
+  for (int round = 0; round < 20; ++round) {
+    for (const std::string& a : names) {
+      for (const double t : times) r.contacts.push_back({a, names[static_cast<std::size_t>(step + 3) % 8], t, step++});
+    }
   }
   physval::RunRecord ref = r;
   ref.engine = "reference";

@@ -67,7 +67,8 @@ RunRecord falling_run(const std::string& scenario, const std::string& engine, do
     r.series.totals.push_back(totals);
     r.series.states.push_back(states);
   }
-  r.final_states = r.series.states.back();
+  const auto last = r.series.states.back();
+  r.final_states = SampleRow(last.begin(), last.end());
   if (contact_time > 0.0) r.contacts.push_back({"ball", "floor", contact_time + error, 1});
   r.metrics["energy_drift"] = std::nullopt;
   r.metrics["position_divergence"] = error * 4.9;

@@ -4,6 +4,14 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <algorithm>
+#include <cstring>
+#include <initializer_list>
+#include <memory>
+#include <new>
+#include <span>
+#include <type_traits>
+#include <utility>
 #include <map>
 #include <optional>
 #include <string>
@@ -30,13 +38,17 @@ struct Totals {
 // comparisons, containment and plots read nothing else; totals are computed from the
 // full state when the sample is taken). 24 bytes, against BodyState's 56: a run's
 // series is what the harness holds per body, hundreds of samples of every body.
+// The padding is a member, always zero, so that a block of samples is sent and cached as
+// its bytes (run_record_io.cpp) without indeterminate ones.
 struct SampleState {
   Vec2 position;
   bool alive = true;
+  std::uint8_t pad[7] = {};
   SampleState() = default;
   SampleState(Vec2 p, bool a) : position(p), alive(a) {}
   SampleState(const BodyState& s) : position(s.position), alive(s.alive) {}   // NOLINT: implicit on purpose
 };
+static_assert(sizeof(SampleState) == 24 && std::is_trivially_copyable_v<SampleState>);
 
 // One sample of every body, made from the engine's full states.
 struct SampleRow : std::vector<SampleState> {
@@ -54,11 +66,149 @@ struct SampleRow : std::vector<SampleState> {
   }
 };
 
+// A run's samples in one block, row after row (row k: the states of every object at the
+// k-th sample; rows grow when particles appear): one allocation a run instead of one a
+// sample, sent between processes and cached as the block's bytes. rows[k] is a span.
+class SampleRows {
+ public:
+  using Row = std::span<SampleState>;
+  using ConstRow = std::span<const SampleState>;
+
+  SampleRows() = default;
+  SampleRows(std::initializer_list<SampleRow> rows) {
+    for (const SampleRow& r : rows) push_back(ConstRow(r.data(), r.size()));
+  }
+  SampleRows(const SampleRows& o) : start_(o.start_) { copy_from(o.data_, o.samples()); }
+  SampleRows(SampleRows&& o) noexcept
+      : data_(std::exchange(o.data_, nullptr)), capacity_(std::exchange(o.capacity_, 0)), start_(std::move(o.start_)) {
+    o.start_.assign(1, 0);
+  }
+  SampleRows& operator=(const SampleRows& o) {
+    if (this != &o) {
+      SampleRows copy(o);
+      swap(copy);
+    }
+    return *this;
+  }
+  SampleRows& operator=(SampleRows&& o) noexcept {
+    SampleRows moved(std::move(o));
+    swap(moved);
+    return *this;
+  }
+  ~SampleRows() { release(); }
+  void swap(SampleRows& o) noexcept {
+    std::swap(data_, o.data_);
+    std::swap(capacity_, o.capacity_);
+    start_.swap(o.start_);
+  }
+
+  std::size_t size() const { return start_.size() - 1; }   // rows
+  bool empty() const { return size() == 0; }
+  std::size_t samples() const { return start_.back(); }    // states in all rows
+  Row operator[](std::size_t k) { return {data_ + start_[k], start_[k + 1] - start_[k]}; }
+  ConstRow operator[](std::size_t k) const { return {data_ + start_[k], start_[k + 1] - start_[k]}; }
+  Row front() { return (*this)[0]; }
+  ConstRow front() const { return (*this)[0]; }
+  Row back() { return (*this)[size() - 1]; }
+  ConstRow back() const { return (*this)[size() - 1]; }
+  SampleState* data() { return data_; }
+  const SampleState* data() const { return data_; }
+  std::size_t row_start(std::size_t k) const { return start_[k]; }   // k <= size()
+
+  // Room for `rows` more rows of `samples` states in all, made at once.
+  void reserve(std::size_t rows, std::size_t samples) {
+    start_.reserve(start_.size() + rows);
+    if (this->samples() + samples > capacity_) grow_to(this->samples() + samples);
+  }
+  void push_back(ConstRow row) {
+    const std::size_t n = samples();
+    if (n + row.size() > capacity_) grow_to(std::max(n + row.size(), 2 * capacity_));
+    if (!row.empty()) std::memcpy(static_cast<void*>(data_ + n), row.data(), row.size() * sizeof(SampleState));
+    start_.push_back(n + row.size());
+  }
+  void push_back(const SampleRow& row) { push_back(ConstRow(row.data(), row.size())); }
+  void push_back(std::initializer_list<SampleState> row) { push_back(ConstRow(row.begin(), row.size())); }
+  void push_back(const std::vector<BodyState>& states) {
+    const std::size_t n = samples();
+    if (n + states.size() > capacity_) grow_to(std::max(n + states.size(), 2 * capacity_));
+    for (std::size_t i = 0; i < states.size(); ++i) new (data_ + n + i) SampleState(states[i]);
+    start_.push_back(n + states.size());
+  }
+  // Rows of the given sizes whose states the caller writes next (run_record_io: read into
+  // place): the block for them, not initialised. Only on an empty SampleRows.
+  SampleState* append_uninitialised(const std::vector<std::size_t>& sizes) {
+    std::size_t n = samples();
+    for (const std::size_t s : sizes) n += s;
+    if (n > capacity_) grow_to(samples() == 0 ? n : std::max(n, 2 * capacity_));
+    SampleState* out = data_ + samples();
+    start_.reserve(start_.size() + sizes.size());
+    for (const std::size_t s : sizes) start_.push_back(start_.back() + s);
+    return out;
+  }
+  // The last row made longer by n states, likewise not initialised.
+  SampleState* extend_last_row_uninitialised(std::size_t n) {
+    const std::size_t have = samples();
+    if (have + n > capacity_) grow_to(std::max(have + n, 2 * capacity_));
+    start_.back() += n;
+    return data_ + have;
+  }
+  void clear() { start_.assign(1, 0); }
+
+  class const_iterator {
+   public:
+    using value_type = ConstRow;
+    using difference_type = std::ptrdiff_t;
+    const_iterator() = default;
+    const_iterator(const SampleRows* rows, std::size_t k) : rows_(rows), k_(k) {}
+    ConstRow operator*() const { return (*rows_)[k_]; }
+    const_iterator& operator++() {
+      ++k_;
+      return *this;
+    }
+    const_iterator operator++(int) {
+      const_iterator old = *this;
+      ++k_;
+      return old;
+    }
+    bool operator==(const const_iterator& o) const { return k_ == o.k_; }
+
+   private:
+    const SampleRows* rows_ = nullptr;
+    std::size_t k_ = 0;
+  };
+  const_iterator begin() const { return {this, 0}; }
+  const_iterator end() const { return {this, size()}; }
+
+ private:
+  void grow_to(std::size_t capacity) {
+    auto* bigger = std::allocator<SampleState>().allocate(capacity);
+    if (samples() > 0) std::memcpy(static_cast<void*>(bigger), data_, samples() * sizeof(SampleState));
+    release();
+    data_ = bigger;
+    capacity_ = capacity;
+  }
+  void copy_from(const SampleState* from, std::size_t n) {
+    if (n == 0) return;
+    data_ = std::allocator<SampleState>().allocate(n);
+    capacity_ = n;
+    std::memcpy(static_cast<void*>(data_), from, n * sizeof(SampleState));
+  }
+  void release() {
+    if (data_ != nullptr) std::allocator<SampleState>().deallocate(data_, capacity_);
+    data_ = nullptr;
+    capacity_ = 0;
+  }
+
+  SampleState* data_ = nullptr;
+  std::size_t capacity_ = 0;
+  std::vector<std::size_t> start_ = {0};   // row k is [start_[k], start_[k + 1])
+};
+
 // States sampled at regular times; states[k][i] is body i at time[k].
 struct Series {
   std::vector<double> time;
   std::vector<Totals> totals;
-  std::vector<SampleRow> states;
+  SampleRows states;
 };
 
 struct ContactRecord {

@@ -3,7 +3,8 @@
 // child writes it straight into the pipe through a small buffer, and the parent reads it
 // straight into a RunRecord, so no intermediate tree or whole-message buffer holds a
 // second copy of the series (what made the parent peak at several times the series'
-// size on scenes of 100k bodies).
+// size on scenes of 100k bodies). The series travels as blocks (times, totals, the rows'
+// sizes, the rows' states as they lie in memory), written from and read into place.
 #pragma once
 
 #include <chrono>
@@ -19,7 +20,7 @@ namespace physval {
 std::vector<std::uint8_t> encode_run_record(const RunRecord& r);
 RunRecord decode_run_record(const std::vector<std::uint8_t>& bytes);   // throws on bad input
 
-// Writes the record to a file descriptor (a pipe) through a 64 KiB buffer. False when a
+// Writes the record to a file descriptor (a pipe) through a 256 kB buffer (a series' blocks: straight from the record). False when a
 // write fails.
 bool write_run_record(int fd, const RunRecord& r);
 
