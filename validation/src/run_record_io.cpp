@@ -222,6 +222,7 @@ struct VectorSource {
   std::size_t at = 0;
   void get(void* p, std::size_t n) {
     if (n > in.size() - at) throw std::runtime_error("run record: truncated");
+    if (n == 0) return;   // p may be an empty vector's null data()
     std::memcpy(p, in.data() + at, n);
     at += n;
   }
@@ -292,6 +293,7 @@ struct FdSource {
   }
   // A long run of bytes: what the buffer holds, then read from the pipe straight into p.
   void get_large(void* p, std::size_t n) {
+    if (n == 0) return;   // p may be an empty vector's null data()
     auto* c = static_cast<std::uint8_t*>(p);
     const std::size_t k = std::min(n, end - begin);
     std::memcpy(c, buffer.get() + begin, k);
