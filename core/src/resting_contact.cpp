@@ -1818,8 +1818,13 @@ std::uint32_t held_partner_key(const World& w, const HeldContact& c) {
 
 // Held bodies are judged again against what they touch now (their supports may have
 // gone); free slow bodies that their contacts can hold are held. Returns whether any
-// body changed. Bodies freed here follow their free path for the step.
-bool hold_pass(World& w, const StepContext& ctx) {
+// body changed. Bodies freed here follow their free path for the step. held_now marks
+// the bodies held by an earlier pass of this step's settling: they were judged then (a
+// group's members together, by try_hold_group, whose test may pass where one member's
+// alone does not), so they are not judged again one by one (else a column held as a
+// group, released one member at a time and held again as a group, never settles: found
+// by the thirteenth hunt).
+bool hold_pass(World& w, const StepContext& ctx, std::vector<char>& held_now) {
   const std::size_t n = w.size();
   double rmax = 0.0;
   bool any = false;
@@ -1835,7 +1840,7 @@ bool hold_pass(World& w, const StepContext& ctx) {
   grid.build(w, std::max(2.0 * rmax, 1e-6 * w.length_scale) * (1.0 + 1e-6));
   bool changed = false;
   for (std::uint32_t i = 0; i < n; ++i) {
-    if (!w.is_held(i)) continue;
+    if (!w.is_held(i) || held_now[i]) continue;
     unhold(w, i);
     w.apath[i] = {};
     grid.query(w.pos[i], near);
@@ -1904,6 +1909,7 @@ bool hold_pass(World& w, const StepContext& ctx) {
     }
     changed = true;
     for (std::uint32_t b : group) {
+      held_now[b] = 1;
       for (const HeldContact& c : w.held) {
         if (c.body != b) continue;
         if (c.other & kBodySupport) {
@@ -2161,6 +2167,8 @@ void apply_supports(World& w, const StepContext& ctx) {
   }
   // Bodies at rest on bodies: valid while the supporter is stuck, they still touch, and
   // they are still held. A stack settles from the bottom up, one level per pass.
+  thread_local std::vector<char> held_now;
+  held_now.assign(n, 0);
   for (bool changed = true; changed;) {
     changed = false;
     for (std::uint32_t i = 0; i < n; ++i) {
@@ -2183,7 +2191,7 @@ void apply_supports(World& w, const StepContext& ctx) {
         changed = true;
       }
     }
-    if (hold_pass(w, ctx)) changed = true;
+    if (hold_pass(w, ctx, held_now)) changed = true;
   }
   judge_braced_holds(w, true);
   if (!w.varying_forces) push_trains(w);
