@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
+#include <tuple>
 
 namespace physval {
 
@@ -95,6 +97,7 @@ ContainmentMonitor::ContainmentMonitor(const Scene& scene) : scene_(scene) {
   for (const BodyDef& d : scene.bodies) radius_.push_back(d.shape == ShapeKind::Point ? 0.0 : d.radius);
   pairs_possible_ = std::any_of(moving_.begin(), moving_.end(), [&](std::size_t i) { return radius_[i] != 0.0; });
   max_radius_ = max_radius;
+  add_pinches(max_radius);
   for (const Barrier& b : barriers_) {
     const double r = b.circle ? b.radius : 0.0;
     barrier_lo_.push_back({std::min(b.a.x, b.b.x) - r - 2.0 * eps_, std::min(b.a.y, b.b.y) - r - 2.0 * eps_});
@@ -184,6 +187,92 @@ ContainmentMonitor::ContainmentMonitor(const Scene& scene) : scene_(scene) {
       }
     }
   }
+}
+
+// The pinches: for each two barriers that do not touch (apart by more than eps) but come
+// closer than the widest moving body's diameter, their closest points. Two segments that do
+// not cross are closest at an end point of one; a circle's closest point to a segment is
+// along the normal from the segment's closest point. Found by a sweep over the barriers'
+// boxes in x (each box grown by the widest diameter), so a long surface costs its
+// neighbours, not its square.
+void ContainmentMonitor::add_pinches(double max_radius) {
+  const double reach = 2.0 * max_radius * (1.0 - ContainmentRecord::kGrazeSlop);
+  if (!(reach > 0.0) || barriers_.size() < 2) return;
+  const std::size_t nb = barriers_.size();
+  std::vector<Vec2> lo(nb), hi(nb);
+  std::vector<std::size_t> order(nb);
+  for (std::size_t k = 0; k < nb; ++k) {
+    const Barrier& b = barriers_[k];
+    const double r = b.circle ? b.radius : 0.0;
+    lo[k] = {std::min(b.a.x, b.b.x) - r, std::min(b.a.y, b.b.y) - r};
+    hi[k] = {std::max(b.a.x, b.b.x) + r, std::max(b.a.y, b.b.y) + r};
+    order[k] = k;
+  }
+  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return lo[x].x < lo[y].x || (lo[x].x == lo[y].x && x < y); });
+  auto closest_on = [](const Barrier& s, Vec2 p) { return s.a + s.dir * std::clamp(dot(p - s.a, s.dir), 0.0, s.len); };
+  auto crosses = [&](const Barrier& s, const Barrier& o) {   // the segments meet (within eps)
+    const double a0 = cross(s.dir, o.a - s.a), a1 = cross(s.dir, o.b - s.a);
+    const double b0 = cross(o.dir, s.a - o.a), b1 = cross(o.dir, s.b - o.a);
+    return ((a0 > eps_ && a1 < -eps_) || (a0 < -eps_ && a1 > eps_)) && ((b0 > eps_ && b1 < -eps_) || (b0 < -eps_ && b1 > eps_));
+  };
+  std::vector<Barrier> found;
+  for (std::size_t x = 0; x < nb; ++x) {
+    const std::size_t k = order[x];
+    for (std::size_t y = x + 1; y < nb && lo[order[y]].x <= hi[k].x + reach; ++y) {
+      const std::size_t l = order[y];
+      if (lo[l].y > hi[k].y + reach || hi[l].y < lo[k].y - reach) continue;
+      const Barrier& A = barriers_[k];
+      const Barrier& B = barriers_[l];
+      Vec2 pa, pb;   // the closest points, on A and on B
+      double width;
+      if (A.circle && B.circle) {
+        const Vec2 d = B.a - A.a;
+        const double dl = length(d);
+        if (!(dl > 0.0)) continue;
+        width = dl - A.radius - B.radius;
+        pa = A.a + d * (A.radius / dl);
+        pb = B.a - d * (B.radius / dl);
+      } else if (A.circle || B.circle) {
+        const Barrier& C = A.circle ? A : B;
+        const Barrier& S = A.circle ? B : A;
+        const Vec2 q = closest_on(S, C.a);
+        const Vec2 d = q - C.a;
+        const double dl = length(d);
+        if (!(dl > 0.0)) continue;
+        width = dl - C.radius;
+        const Vec2 on_c = C.a + d * (C.radius / dl);
+        pa = A.circle ? on_c : q;
+        pb = A.circle ? q : on_c;
+      } else {
+        if (crosses(A, B)) continue;
+        width = std::numeric_limits<double>::infinity();
+        for (const auto& [p, s, from_a] : {std::tuple{A.a, &B, true}, std::tuple{A.b, &B, true},
+                                           std::tuple{B.a, &A, false}, std::tuple{B.b, &A, false}}) {
+          const Vec2 q = closest_on(*s, p);
+          const double dl = length(q - p);
+          if (dl < width) {
+            width = dl;
+            pa = from_a ? p : q;
+            pb = from_a ? q : p;
+          }
+        }
+      }
+      if (!(width > eps_) || !(width < reach)) continue;   // touching, joined, or wide enough for every body
+      Barrier g;
+      g.pinch = true;
+      g.a = pa;
+      g.b = pb;
+      g.len = length(pb - pa);
+      if (!(g.len > 0.0)) continue;
+      g.dir = (pb - pa) / g.len;
+      g.width = width;
+      g.group = A.group;
+      g.group2 = B.group;
+      g.what = "the gap between " + A.what + " and " + B.what;
+      found.push_back(std::move(g));
+    }
+  }
+  for (Barrier& g : found) barriers_.push_back(std::move(g));
 }
 
 void ContainmentMonitor::candidates(Vec2 lo, Vec2 hi) {
@@ -690,7 +779,10 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
     auto check = [&](std::uint32_t k) {
       const Barrier& b = barriers_[k];
       if (!blocks[b.group] || (b.circle && b.body == parent_of(i))) return;
-      if (b.circle) {
+      if (b.pinch && (!blocks[b.group2] || 2.0 * r * (1.0 - ContainmentRecord::kGrazeSlop) <= b.width)) return;   // it fits
+      if (b.pinch) {
+        // no barrier: its barriers' own tests give the penetration
+      } else if (b.circle) {
         const double depth = r + b.radius - length(p1 - b.a);
         if (depth > record_.max_penetration) penetration(depth, t, name(i) + " / " + b.what);
       } else {
@@ -770,7 +862,7 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
             // against it).
             const bool box = b.owner >= scene_.walls.size() && b.owner < scene_.walls.size() + scene_.boxes.size();
             for (const Barrier& o : barriers_) {
-              if (o.circle || ((o.a != c && o.b != c) && !(box && o.owner == b.owner))) continue;
+              if (o.circle || o.pinch || ((o.a != c && o.b != c) && !(box && o.owner == b.owner))) continue;
               for (const Vec2 q : {p0, p1}) limit = std::min(limit, reach - slop - (r - segment_distance(q, o.a, o.dir, o.len)));
             }
           }
@@ -798,6 +890,11 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
         if (!record_.first_escape_time) {
           record_.first_escape_time = t;
           record_.first_escape = name(i) + " through " + b.what;
+          if (b.pinch) {
+            char text[96];
+            std::snprintf(text, sizeof text, " (%.6g m wide, narrower than its %.6g m diameter)", b.width, 2.0 * r);
+            record_.first_escape += text;
+          }
         }
       }
     };

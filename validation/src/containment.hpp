@@ -72,7 +72,15 @@ class ContainmentMonitor {
   // it to the comparator, past the bodies.
   std::size_t owner = static_cast<std::size_t>(-1);
     std::string what;      // "wall 'left'"
+    // A pinch: the narrowest span between two barriers that do not touch (the gap of a drain
+    // between two floor pieces, two pegs, a peg and a wall), a and b its ends on them. No
+    // barrier itself: a body wider than it (2 r (1 - kGrazeSlop) > width) that crosses it
+    // went through an opening narrower than itself, an escape as through a wall.
+    bool pinch = false;
+    double width = 0.0;
+    std::size_t group2 = 0;   // the second barrier's group (both must block the body)
   };
+  void add_pinches(double max_radius);
   void candidates(Vec2 lo, Vec2 hi);
   void track_particles(std::size_t count);
   std::string name(std::size_t i) const;   // a scene body's or a particle's
