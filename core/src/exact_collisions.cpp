@@ -961,6 +961,15 @@ class EventLoop {
     }
   }
 
+  // Body i meets end point k at t: resolved with every other end point and face it touches
+  // then, as one set (resolve_simultaneous with end points); false when it touches no other.
+  bool cap_set(std::uint32_t i, std::uint32_t k, double t) {
+    w_.sim_caps = true;
+    const bool done = resolve_simultaneous(w_, i, kSimultaneousFace | k, t, set_, impacted_);
+    w_.sim_caps = false;
+    return done;
+  }
+
   void process_static(std::uint32_t i, std::uint32_t k, std::uint8_t feature, double t, double t_abs,
                       bool from_back) {
     const Segment& seg = w_.statics.segments[k];
@@ -1051,6 +1060,17 @@ class EventLoop {
       // Body i touches other bodies or faces at this instant: Newton's law at all of
       // its contacts at once (a ball wedged between a wall and another ball).
         finish_simultaneous(t, t_abs);
+      return;
+    } else if (slow && !face && !w_.supported(i) && !w_.stationary(i) && hold(i)) {
+      // Pressed onto an end point and something else (the other end of a drain narrower
+      // than it): held at rest there if its contacts together can hold it.
+    } else if (!face && !w_.supported(i) && !w_.any_rules && cap_set(i, k, t)) {
+      // A free body meeting an end point and, at the same instant, another end point or a
+      // face (a ball dropped onto a drain narrower than it lands on both of its ends):
+      // Newton's law at all of them at once. One at a time, the end listed first took the
+      // whole impact and a ball dropped square onto a drain left it 60 degrees off the
+      // vertical, to the side the walls' order gave (the fourteenth hunt).
+      finish_simultaneous(t, t_abs);
       return;
     } else if (slow && !face && !w_.supported(i) && settle_on_cap(w_, i, t, ctx_.t0, ctx_.dt, true)) {
       // A free body meeting a convex corner too slowly to bounce clear rides its cap

@@ -404,7 +404,24 @@ static void touching_supports(World& w, std::uint32_t i, std::span<const std::ui
       const Segment& s = w.statics.segments[k];
       if (w.any_rules && !w.response(w.group[i], s.group).collide) continue;
       const double u = dot(p - s.from, s.dir);
-      if (u < 0.0 || u > s.length) continue;
+      if (u < 0.0 || u > s.length) {
+        // A free end point (no other segment ends there: not a corner or a joint, which the
+        // cap rides of convex_cap.cpp take): a support along the line from it to the
+        // centre (the two ends of a drain narrower than the body hold it).
+        const Vec2 q = u < 0.0 ? s.from : s.to;
+        const Vec2 d = p - q;
+        const double dl = length(d);
+        if (!(dl > 0.0) || std::fabs(dl - r) > tol) continue;
+        const bool shared = std::any_of(w.found_static.begin(), w.found_static.end(), [&](std::uint32_t o) {
+          const Segment& t = w.statics.segments[o];
+          return o != k && (length(t.from - q) <= tol || length(t.to - q) <= tol);
+        });
+        if (shared) continue;
+        out.push_back({i, kBodySupport | k, d / dl});
+        mu.push_back(holding_coefficient(w.pair_material(w.material[i], s.material)));
+        if (restitution) restitution->push_back(w.pair_material(w.material[i], s.material).restitution);
+        continue;
+      }
       const double D = dot(p - s.from, s.normal);
       if (std::fabs(std::fabs(D) - r) > tol) continue;
       out.push_back({i, kBodySupport | k, toi::line_side(D, dot(w.vel[i], s.normal), dot(w.acc[i], s.normal)) * s.normal});

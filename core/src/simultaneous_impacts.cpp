@@ -167,11 +167,20 @@ bool touching_face(const World& w, std::uint32_t i, std::uint32_t k, double t, d
   const Segment& s = w.statics.segments[k];
   const Vec2 p = pos_now(w, i, t);
   const double u = dot(p - s.from, s.dir);
-  if (u < 0.0 || u > s.length) return false;
-  const double D = dot(p - s.from, s.normal);
   const double scale = inf_norm(p) + w.radius[i] + inf_norm(s.from) + inf_norm(s.to);
-  if (std::fabs(D) - w.radius[i] > kGapUlps * kEps * scale) return false;
-  const Vec2 n = D >= 0.0 ? s.normal : -s.normal;
+  Vec2 n;
+  if (u < 0.0 || u > s.length) {
+    // Beyond the face: its end point (a convex cap), in a set seeded by a cap impact only.
+    if (!w.sim_caps) return false;
+    const Vec2 d = p - (u < 0.0 ? s.from : s.to);
+    const double dl = length(d);
+    if (!(dl > 0.0) || std::fabs(dl - w.radius[i]) > kGapUlps * kEps * scale) return false;
+    n = d / dl;
+  } else {
+    const double D = dot(p - s.from, s.normal);
+    if (std::fabs(D) - w.radius[i] > kGapUlps * kEps * scale) return false;
+    n = D >= 0.0 ? s.normal : -s.normal;
+  }
   const Vec2 v = vel_now(w, i, t);
   const double vscale = length(v);
   if (dot(v, n) > kGapUlps * kEps * std::max(vscale, set_speed) && !w.sim_with_separating) return false;
@@ -379,8 +388,10 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
         if (!touching_face(w, i, k, t, set_speed, c)) continue;
         const Segment& s = w.statics.segments[k];
         if (s.normal_from.x != 0.0 || s.normal_from.y != 0.0) return false;
-        const bool known = std::any_of(contacts.begin(), contacts.end(),
-                                       [&](const Contact& x) { return x.a == c.a && x.b == c.b; });
+        // (an end point shared by two segments is one contact: the same normal to the bit)
+        const bool known = std::any_of(contacts.begin(), contacts.end(), [&](const Contact& x) {
+          return (x.a == c.a && x.b == c.b) || ((x.a & kSegmentContact) && x.b == c.b && x.n == c.n);
+        });
         if (known) continue;
         const PairMaterial m = w.pair_material(w.material[i], s.material);
         add(c, m.restitution, m.static_friction, m.friction);

@@ -133,6 +133,9 @@ struct World {
   // simultaneous set then takes its touching contacts that separate too (the LCP gives
   // them no impulse unless the others' impulses would close them).
   bool sim_with_separating = false;
+  // resolve_simultaneous seeded by an impact on a segment's end point: the set's bodies
+  // touch end points (convex caps) as well as faces (touching_face).
+  bool sim_caps = false;
   // Set by the event loop to solve such a cycling set again perfectly inelastically (every
   // contact's restitution 0, collapse_speed infinite) when Newton's law with the
   // separating contacts would raise its kinetic energy (see exact_collisions.cpp).
