@@ -726,6 +726,7 @@ class EventLoop {
     double min_sep = 0.0;
     bool settled = false;
     double closing = 0.0, rest_vr = 0.0;   // the pair's closing speed and rest speed, when pressed
+    bool noted = false;                     // counted as a storm's impact
     if (w_.any_forces) {
       const double an = dot(impact_acceleration(w_, j) - impact_acceleration(w_, i), n);   // (the face's case, below)
       const double vn = dot(w_.vel[j] - w_.vel[i], n);
@@ -734,7 +735,7 @@ class EventLoop {
         closing = -vn;
         rest_vr = vr;
         if (m.restitution * std::max(0.0, -vn) < vr) {
-          if (storms_) note_storm_impact(w_, i, j);   // an impact storm makes a granular group
+          if (storms_) note_storm_impact(w_, i, j), noted = true;   // an impact storm makes a granular group
           // Pressed together and too slow to bounce clear. Onto a body at rest: come to
           // rest on it (a stack). Otherwise a micro-bounce with a flight of at least
           // ~1/8 step instead of endless impacts.
@@ -769,6 +770,12 @@ class EventLoop {
       if (same_instant_[x]++ == 0) counted_.push_back(x);
     }
     const bool cycling = same_instant_[i] > kCycle || same_instant_[j] > kCycle;
+    // A pair met again and again at one instant is an impact storm whether or not the field
+    // presses it (a row of balls, some sliding and some in flight, pressed together by the
+    // sliders' friction alone: the fourteenth hunt's row of six met one set of four at one
+    // instant for ever, each set ~3.5 ms), so it counts towards the granular mode as a
+    // pressed slow impact does (once).
+    if (storms_ && cycling && !noted) note_storm_impact(w_, i, j);
     // A pressed, slow body that the impulses leave exactly as it was would meet the same
     // impact at the same instant for ever: wedged, it is held where it is.
     const auto wedged = [&]() {

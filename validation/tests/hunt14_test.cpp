@@ -187,5 +187,23 @@ TEST_F(Hunt14, ABallPushedThroughANarrowDrainIsDiverged) {
   EXPECT_GE(fell, 1) << "the scene no longer shows the squeeze (the hunt saw Bullet, Chipmunk and ODE do it)";
 }
 
+// Six balls (e 0.6, mu 0.2) settle into one row filling a 1.2 m box's width. At dt/8 (the
+// reference) one simultaneous set of four touching balls in the row, some sliding and some in
+// flight, pressed together by the sliders' friction alone, was met again and again at one
+// instant from t = 1.17 s (~3.5 ms a set): the step crawled towards the event cap, about an
+// hour, and `physval run` never returned (with --timeout, `error`). A pair met at one instant
+// over and over now counts as an impact storm, and the granular mode takes the row.
+TEST_F(Hunt14, ARowOfSixFillingTheBoxFinishes) {
+  const fs::path scene = fs::path(PHYSVAL_TESTS_DIR) / "hunt14" / "row_of_six_crawl.toml";
+  const fs::path out = dir_ / "out";
+  const Result r = physval("run " + scene.string() + " --engines core --quiet --no-cache --timeout 300 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::ifstream in(out / "results.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["runs"].size(), 1u);
+  EXPECT_EQ(j["runs"][0]["status"], "ok") << j["runs"][0].value("reason", "");
+  EXPECT_EQ(j["references"][0]["available"], true) << j["references"][0].value("reason", "");
+}
+
 }  // namespace
 }  // namespace physval
