@@ -52,9 +52,94 @@ CoreEngine::~CoreEngine() = default;
 
 const EngineInfo& CoreEngine::info() const { return core_info(); }
 
+namespace {
+
+// The bounding box of everything in the scene (bodies with their radii, walls, boxes,
+// surfaces); false when there is nothing.
+bool scene_box(const Scene& scene, Vec2& lo, Vec2& hi) {
+  lo = {INFINITY, INFINITY};
+  hi = {-INFINITY, -INFINITY};
+  auto add = [&](Vec2 p, double r) {
+    lo = {std::min(lo.x, p.x - r), std::min(lo.y, p.y - r)};
+    hi = {std::max(hi.x, p.x + r), std::max(hi.y, p.y + r)};
+  };
+  for (const BodyDef& b : scene.bodies) add(b.position, b.shape == ShapeKind::Point ? 0.0 : b.radius);
+  for (const WallDef& w : scene.walls) { add(w.from, 0.0); add(w.to, 0.0); }
+  for (const BoxDef& b : scene.boxes) { add(b.min, 0.0); add(b.max, 0.0); }
+  for (const SurfaceDef& s : scene.surfaces) for (Vec2 p : s.points) add(p, 0.0);
+  return lo.x <= hi.x && lo.y <= hi.y;
+}
+
+// Core's round-off tolerances are 1e-9 of the scene's extent from the origin
+// (World::length_scale), so a scene drawn far from the origin (a map's grid: a 5 mm marble
+// 4 mm above a floor at x 5e5, y 5e6 m) had a 5 mm tolerance: the marble was held up as
+// resting for the whole run, and the reference converged to that. Physics does not depend
+// on where the origin is, so a scene whose centre is farther from the origin than 8 x its
+// own size is run in coordinates from its centre (rounded to a multiple of its size's
+// power of two, so the subtraction keeps the low bits); every other scene runs as given, to
+// the bit.
+Vec2 working_origin(const Scene& scene) {
+  Vec2 lo, hi;
+  if (!scene_box(scene, lo, hi)) return {};
+  const Vec2 c = 0.5 * (lo + hi);
+  const double size = std::max({hi.x - lo.x, hi.y - lo.y, 1e-300});
+  if (!std::isfinite(size) || !(std::max(std::fabs(c.x), std::fabs(c.y)) > 8.0 * size)) return {};
+  const double q = std::exp2(std::ceil(std::log2(size)));
+  return {std::round(c.x / q) * q, std::round(c.y / q) * q};
+}
+
+void move_scene(Scene& s, Vec2 by) {
+  for (BodyDef& b : s.bodies) b.position = b.position + by;
+  for (WallDef& w : s.walls) { w.from = w.from + by; w.to = w.to + by; }
+  for (BoxDef& b : s.boxes) { b.min = b.min + by; b.max = b.max + by; }
+  for (SurfaceDef& sf : s.surfaces) for (Vec2& p : sf.points) p = p + by;
+}
+
+// A scene whose extent (even from its own centre) is so much larger than its smallest
+// moving circle that core's round-off tolerance, 1e-9 of the extent, exceeds 1e-3 of that
+// radius cannot be core's to run: a body would be held as resting, or counted touching, that
+// far from a support (a 0.05 m ball in a 2 m box beside a body parked at 1e11 m hovered
+// 1.45 m above the floor, and the Sun 1 AU away did the same: the fifteenth hunt). Refused
+// at load, saying why, when there is anything static to rest on.
+void check_resolution(const World& w, const Scene& scene) {
+  bool statics = !scene.walls.empty() || !scene.boxes.empty() || !scene.surfaces.empty();
+  double r_min = INFINITY;
+  const BodyDef* smallest = nullptr;
+  for (const BodyDef& b : scene.bodies) {
+    if (b.is_static) {
+      statics = statics || (b.shape != ShapeKind::Point && b.radius > 0.0);
+      continue;
+    }
+    if (b.shape == ShapeKind::Point || !(b.radius > 0.0) || !(b.radius < r_min)) continue;
+    r_min = b.radius;
+    smallest = &b;
+  }
+  const double tol = 1e-9 * w.length_scale;
+  if (!statics || smallest == nullptr || !(tol > 1e-3 * r_min)) return;
+  std::ostringstream m;
+  m.precision(3);
+  m << "core cannot resolve this scene: it spans " << w.length_scale << " m (from "
+    << (w.origin.x != 0.0 || w.origin.y != 0.0 ? "its centre" : "the origin") << "), so core's round-off tolerance ("
+    << "1e-9 of that, " << tol << " m) is more than 1e-3 of body '" << smallest->name << "''s radius (" << r_min
+    << " m): a body could be held resting that far from a support. Bring the scene's objects nearer each other "
+       "(or split the scene)";
+  throw std::invalid_argument(m.str());
+}
+
+}  // namespace
+
 void CoreEngine::load(const Scene& scene) {
   auto w = std::make_unique<World>();
-  core_detail::load_world(*w, scene);
+  const Vec2 origin = working_origin(scene);
+  if (origin.x != 0.0 || origin.y != 0.0) {
+    Scene moved = scene;
+    move_scene(moved, -1.0 * origin);
+    core_detail::load_world(*w, moved);
+    w->origin = origin;
+  } else {
+    core_detail::load_world(*w, scene);
+  }
+  check_resolution(*w, scene);
   world_ = std::move(w);
 }
 
@@ -133,9 +218,10 @@ BodyMeta CoreEngine::body_meta(std::size_t i) const {
 void CoreEngine::read_states(std::vector<BodyState>& out) const {
   const World& w = *world_;
   out.resize(w.size());
+  const bool moved = w.origin.x != 0.0 || w.origin.y != 0.0;
   for (std::size_t i = 0; i < w.size(); ++i) {
     BodyState& s = out[i];
-    s.position = w.pos[i];
+    s.position = moved ? w.pos[i] + w.origin : w.pos[i];
     s.velocity = w.vel[i];
     s.angle = w.angle.empty() ? 0.0 : w.angle[i];
     s.angular_velocity = 0.0;   // bodies do not spin (lecture step 6)

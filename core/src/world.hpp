@@ -162,6 +162,10 @@ struct World {
   double time = 0.0;
   double end_time = 0.0;         // the scene's duration: its run's last step ends there
   double length_scale = 1.0;     // extent of the scene, for round-off tolerances
+  // Where core's working origin sits in scene coordinates (core_engine.cpp, working_origin):
+  // 0 but for a scene far from the origin next to its size, which core runs in coordinates
+  // from its centre; read_states adds it back.
+  Vec2 origin;
   double rest_factor = 1.0 / 16.0;   // auto rest speed = rest_factor |a_n| dt
 
   // ---- bodies (structure of arrays). Optional arrays are empty when unused.

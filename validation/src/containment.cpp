@@ -90,18 +90,24 @@ ContainmentMonitor::ContainmentMonitor(const Scene& scene) : scene_(scene) {
       max_radius = std::max(max_radius, r);
     }
   }
-  for (const Barrier& b : barriers_) {
+  // Round-off is local: a test between a body and a barrier, or two bodies, is as exact as
+  // the coordinates it subtracts, so each barrier carries 1e-9 of its own coordinates (at
+  // least 1e-9 m) and each test takes the larger of that and its bodies' (eps_at). One
+  // scale for the whole scene let a far object blind every test: a ball tunnelling out of
+  // a 2 m box was not an escape in a scene that also held the Sun 1 AU away (the tolerance
+  // 150 m), nor beside a body parked at 1e11 m (the fifteenth hunt).
+  for (Barrier& b : barriers_) {
+    b.eps = eps_at(b.a, b.b, b.circle ? b.radius : 0.0);
     extent = std::max({extent, std::fabs(b.a.x), std::fabs(b.a.y), std::fabs(b.b.x), std::fabs(b.b.y)});
   }
-  eps_ = 1e-9 * extent;
   for (const BodyDef& d : scene.bodies) radius_.push_back(d.shape == ShapeKind::Point ? 0.0 : d.radius);
   pairs_possible_ = std::any_of(moving_.begin(), moving_.end(), [&](std::size_t i) { return radius_[i] != 0.0; });
   max_radius_ = max_radius;
   add_pinches(max_radius);
   for (const Barrier& b : barriers_) {
     const double r = b.circle ? b.radius : 0.0;
-    barrier_lo_.push_back({std::min(b.a.x, b.b.x) - r - 2.0 * eps_, std::min(b.a.y, b.b.y) - r - 2.0 * eps_});
-    barrier_hi_.push_back({std::max(b.a.x, b.b.x) + r + 2.0 * eps_, std::max(b.a.y, b.b.y) + r + 2.0 * eps_});
+    barrier_lo_.push_back({std::min(b.a.x, b.b.x) - r - 2.0 * b.eps, std::min(b.a.y, b.b.y) - r - 2.0 * b.eps});
+    barrier_hi_.push_back({std::max(b.a.x, b.b.x) + r + 2.0 * b.eps, std::max(b.a.y, b.b.y) + r + 2.0 * b.eps});
   }
 
   // The open box, grown from the moving bodies' mean position: each barrier box is left
@@ -213,7 +219,8 @@ void ContainmentMonitor::add_pinches(double max_radius) {
   auto crosses = [&](const Barrier& s, const Barrier& o) {   // the segments meet (within eps)
     const double a0 = cross(s.dir, o.a - s.a), a1 = cross(s.dir, o.b - s.a);
     const double b0 = cross(o.dir, s.a - o.a), b1 = cross(o.dir, s.b - o.a);
-    return ((a0 > eps_ && a1 < -eps_) || (a0 < -eps_ && a1 > eps_)) && ((b0 > eps_ && b1 < -eps_) || (b0 < -eps_ && b1 > eps_));
+    const double e = std::max(s.eps, o.eps);
+    return ((a0 > e && a1 < -e) || (a0 < -e && a1 > e)) && ((b0 > e && b1 < -e) || (b0 < -e && b1 > e));
   };
   std::vector<Barrier> found;
   for (std::size_t x = 0; x < nb; ++x) {
@@ -257,7 +264,7 @@ void ContainmentMonitor::add_pinches(double max_radius) {
           }
         }
       }
-      if (!(width > eps_) || !(width < reach)) continue;   // touching, joined, or wide enough for every body
+      if (!(width > std::max(A.eps, B.eps)) || !(width < reach)) continue;   // touching, joined, or wide enough for every body
       Barrier g;
       g.pinch = true;
       g.a = pa;
@@ -266,6 +273,7 @@ void ContainmentMonitor::add_pinches(double max_radius) {
       if (!(g.len > 0.0)) continue;
       g.dir = (pb - pa) / g.len;
       g.width = width;
+      g.eps = std::max(A.eps, B.eps);
       g.group = A.group;
       g.group2 = B.group;
       g.what = "the gap between " + A.what + " and " + B.what;
@@ -282,8 +290,9 @@ void ContainmentMonitor::candidates(Vec2 lo, Vec2 hi) {
     return;
   }
   const double inv = 1.0 / cell_;
-  const std::int64_t x0 = cell_index(lo.x - eps_, inv), x1 = cell_index(hi.x + eps_, inv);
-  const std::int64_t y0 = cell_index(lo.y - eps_, inv), y1 = cell_index(hi.y + eps_, inv);
+  const double pad = eps_at(lo, hi, 0.0);   // the body's own round-off; each barrier's box carries its own
+  const std::int64_t x0 = cell_index(lo.x - pad, inv), x1 = cell_index(hi.x + pad, inv);
+  const std::int64_t y0 = cell_index(lo.y - pad, inv), y1 = cell_index(hi.y + pad, inv);
   if (static_cast<double>(x1 - x0 + 1) * static_cast<double>(y1 - y0 + 1) > static_cast<double>(barriers_.size())) {
     for (std::uint32_t k = 0; k < barriers_.size(); ++k) found_.push_back(k);   // a long path: test them all
     return;
@@ -376,7 +385,8 @@ void ContainmentMonitor::start(const std::vector<BodyState>& states) {
       const Barrier& b = barriers_[k];
       if (b.circle || !blocks_[body_group_[i]][b.group]) continue;
       const double d = cross(b.dir, p - b.a), u = dot(p - b.a, b.dir);
-      if (d != 0.0 && std::abs(d) <= eps_ && u >= -eps_ && u <= b.len + eps_) {
+      const double e = std::max(b.eps, eps_at(p, p, 0.0));
+      if (d != 0.0 && std::abs(d) <= e && u >= -e && u <= b.len + e) {
         on_line_[static_cast<std::uint64_t>(i) * barriers_.size() + k] = static_cast<signed char>(d > 0.0 ? 1 : -1);
       }
     }
@@ -653,7 +663,8 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
       // closest approach plus a bend (>= 0) is never below the approach alone, so when the
       // centres are inside now, or the path never comes inside, the answer is the same.
       double closest = ri + rj - depth;
-      const double inside = into - eps_;
+      const double eps = eps_at(xi, xj, 0.0);
+      const double inside = into - eps;
       bool into_each_other = closest < inside;
       if (!into_each_other) {
         const Vec2 d0 = before(i) - before(j), dd = (xi - xj) - d0;
@@ -675,7 +686,7 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
         // across the bend cuts the corner: core's exact runs in a box were reported with
         // the end-state test's looser bend). At a step's end a point may sit inside by a
         // solver's slop, so ends still need half the radius.
-        if (!into_each_other && length(d0) >= ri + rj - eps_ && closest >= ri + rj - eps_) {
+        if (!into_each_other && length(d0) >= ri + rj - eps && closest >= ri + rj - eps) {
           const double seen = std::min(ri, rj) == 0.0 ? 0.1 * (ri + rj) : 0.5 * std::min(ri, rj);
           if (along < ri + rj - seen) {
             const double off = kink(i) + kink(j);
@@ -690,11 +701,11 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
         // test above left it).
         if (!into_each_other) {
           const double start_depth = ri + rj - length(d0), end_depth = ri + rj - closest;
-          const double ends = start_depth <= eps_ && end_depth <= eps_ ? 0.0 : std::max(start_depth, end_depth);
+          const double ends = start_depth <= eps && end_depth <= eps ? 0.0 : std::max(start_depth, end_depth);
           const double seen = std::min(ri, rj) == 0.0 ? 0.1 * (ri + rj) : 0.5 * std::min(ri, rj);
           // Deeper than half the smaller radius at a point of the chord deeper than both its
           // ends (a contact being resolved is deepest at an end).
-          const double limit = std::min(ri + rj - seen, ri + rj - ends - eps_);
+          const double limit = std::min(ri + rj - seen, ri + rj - ends - eps);
           if (along < limit) {
             const double off = straight_either(i) + straight_either(j);
             into_each_other = off < 0.25 * seen && along + off < limit;
@@ -790,6 +801,7 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
         if (depth > record_.max_penetration) penetration(depth, t, name(i) + " / " + b.what);
       }
       if (escaped_[i] || p0 == p1) return;
+      const double eps = std::max(b.eps, eps_at(p0, p1, 0.0));
       bool through = false;
       if (b.circle) {
         const Vec2 d = p1 - p0;
@@ -797,14 +809,14 @@ void ContainmentMonitor::observe(double t, const std::vector<BodyState>& states)
         const double u = std::clamp(dot(b.a - p0, d) / len2, 0.0, 1.0);
         // Into a static body's circle (the centre closer to its centre than its radius):
         // deeper than the moving body's own radius, through or on its way through.
-        through = length(p0 - b.a) >= b.radius - eps_ && length(p0 + d * u - b.a) < b.radius - eps_;
+        through = length(p0 - b.a) >= b.radius - eps && length(p0 + d * u - b.a) < b.radius - eps;
       } else {
         const double d0 = cross(b.dir, p0 - b.a), d1 = cross(b.dir, p1 - b.a);
-        const int s0 = d0 > eps_ ? 1 : d0 < -eps_ ? -1 : 0;
-        const int s1 = d1 > eps_ ? 1 : d1 < -eps_ ? -1 : 0;
+        const int s0 = d0 > eps ? 1 : d0 < -eps ? -1 : 0;
+        const int s1 = d1 > eps ? 1 : d1 < -eps ? -1 : 0;
         auto within = [&](Vec2 q) {
           const double u = dot(q - b.a, b.dir);
-          return u >= -eps_ && u <= b.len + eps_;
+          return u >= -eps && u <= b.len + eps;
         };
         const std::uint64_t key = static_cast<std::uint64_t>(i) * barriers_.size() + k;
         if (s0 != 0 && s1 == -s0) {

@@ -19,6 +19,8 @@
 // core's lecture mode let an explosion's particles out of a closed box, `ok`).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -65,6 +67,7 @@ class ContainmentMonitor {
     Vec2 dir;         // unit, a -> b
     double len = 0.0;
     double radius = 0.0;   // circles
+    double eps = 1e-9;     // round-off of tests against it: eps_at(a, b, radius)
     std::size_t group = 0;   // index into barrier groups
     std::size_t body = static_cast<std::size_t>(-1);   // a static body's index
     // A segment's barrier: its index among the walls, then the boxes, then the surfaces
@@ -137,7 +140,11 @@ class ContainmentMonitor {
   // Few barriers: an open box that overlaps none of the barrier boxes above (for each,
   // beyond one of its sides); a body whose swept box lies strictly inside it skips them.
   Vec2 open_lo_{0.0, 0.0}, open_hi_{0.0, 0.0};   // empty unless open_lo_ < open_hi_
-  double eps_ = 1e-9;
+  // 1e-9 of the largest coordinate among p and q, grown by r (at least 1e-9 m): the
+  // round-off allowed a test that subtracts those points' coordinates.
+  static double eps_at(Vec2 p, Vec2 q, double r) {
+    return 1e-9 * std::max({1.0, std::fabs(p.x) + r, std::fabs(p.y) + r, std::fabs(q.x) + r, std::fabs(q.y) + r});
+  }
 
   // A uniform grid over the barriers (used when there are many).
   bool use_grid_ = false;
