@@ -267,7 +267,7 @@ void load_world(World& w, const Scene& scene) {
   for (const Segment& s : w.statics.segments) {
     extent = std::max({extent, std::fabs(s.from.x), std::fabs(s.from.y), std::fabs(s.to.x), std::fabs(s.to.y)});
   }
-  w.length_scale = std::max(1.0, extent + max_radius);
+  w.length_scale = std::max(1e-9, extent + max_radius);
   w.statics.build(std::max(2.0 * max_radius, 1e-3 * w.length_scale));
 
   // Emitters: particles take their parent's group.

@@ -65,6 +65,30 @@ TEST(CoreFarScene, AMarbleFarFromTheOriginFallsAndBouncesAsAtTheOrigin) {
   }
 }
 
+// The other end of the scale: a marble of radius 1e-7 to 1e-2 m released 0.5% of its
+// radius above a floor (0.5 nm for the smallest). The tolerance was 1e-9 of the extent but
+// never below 1e-9 m, so below a metre it stopped shrinking with the scene: the 0.1 um
+// marble was taken as touching at t = 0 and held in the air. Now it is 1e-9 of the extent
+// at every scale: the first two impacts at the closed form to 1e-6 of the first's time.
+TEST(CoreFarScene, ASmallMarbleFallsAsALargeOneDoes) {
+  for (double r : {1e-7, 1e-6, 1e-4, 1e-2}) {
+    for (double e : {0.5, 1.0}) {
+      SCOPED_TRACE("r " + std::to_string(r) + " e " + std::to_string(e));
+      const double gap = 0.005 * r;
+      Scene s = scene_of({circle("marble", {0.0, r + gap}, {}, r, 1.0, e)},
+                         {wall("floor", {-100.0 * r, 0.0}, {100.0 * r, 0.0}, e)}, {0.0, -g});
+      const double held = (r + gap) - r;
+      const double t1 = std::sqrt(2.0 * held / g);
+      const double t2 = t1 + 2.0 * e * t1;
+      Sim sim(s);
+      sim.run_until(1.5 * t2, t2 / 16.0);
+      ASSERT_GE(sim.contacts.size(), 2u);
+      EXPECT_NEAR(sim.contacts[0].time, t1, 1e-6 * t1);
+      EXPECT_NEAR(sim.contacts[1].time, t2, 1e-6 * t1);
+    }
+  }
+}
+
 // The same bounces give the same states at the origin and at (5e6, -3e6) m, up to the
 // round-off of positions there.
 TEST(CoreFarScene, ASceneMovedFarAwayGivesTheSameStatesMovedAlong) {

@@ -491,7 +491,9 @@ void check_expectations(RunRecord& run, const Scene& scene) {
 // may differ by 1e-6 x its own scale + 1e-9 m, its scale being the largest of its own
 // travel in `fine` (the finer run), its radius and the lower median of all bodies' travel
 // (which no single body moves): one body parked 1e7 m away made an unconverged gas
-// "converged to 1.4 m" when the scale was shared.
+// "converged to 1.4 m" when the scale was shared. The 1e-9 m floor shrinks with a scene
+// smaller than a metre (1e-9 of its size): a 0.1 um ball's runs could differ by 1% of its
+// radius and count as converged (the fifteenth hunt).
 std::vector<double> convergence_limits(const Scene& scene, const Series& fine) {
   const std::size_t nb = scene.bodies.size();
   std::vector<double> travel(nb, 0.0);
@@ -508,7 +510,8 @@ std::vector<double> convergence_limits(const Scene& scene, const Series& fine) {
     typical = sorted[(nb - 1) / 2];
   }
   std::vector<double> limits(nb);
-  for (std::size_t i = 0; i < nb; ++i) limits[i] = 1e-6 * std::max({travel[i], scene.bodies[i].radius, typical}) + 1e-9;
+  const double floor = 1e-9 * std::min(1.0, characteristic_scales(scene, nullptr).length);
+  for (std::size_t i = 0; i < nb; ++i) limits[i] = 1e-6 * std::max({travel[i], scene.bodies[i].radius, typical}) + floor;
   return limits;
 }
 

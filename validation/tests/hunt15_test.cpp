@@ -191,5 +191,20 @@ TEST_F(Hunt15, AMarbleOnAMapGridLandsAtTheClosedForm) {
   EXPECT_EQ(j["references"][0]["converged"], true);
 }
 
+// A 1 um marble 0.1 um above a floor: core lands it at the closed form and is judged
+// against its reference to 1e-6 of its own scale (the limit was 1e-9 m, 1e-3 of the radius,
+// at every scale below a metre).
+TEST_F(Hunt15, AMicronMarbleIsHeldToItsOwnScale) {
+  const nlohmann::json j = run("micro_marble.toml", "--engines core");
+  ASSERT_EQ(j["runs"].size(), 1u);
+  const auto& r = j["runs"][0];
+  EXPECT_EQ(r["status"], "ok") << r.value("reason", "");
+  ASSERT_FALSE(r["contacts"].empty());
+  EXPECT_NEAR(r["contacts"][0]["time"].get<double>(), std::sqrt(2.0 * ((1.1e-6 - 1e-6)) / 9.8), 1e-12);
+  ASSERT_TRUE(r["reference_check"].is_object());
+  EXPECT_EQ(r["reference_check"]["judged"], true);
+  EXPECT_LT(r["reference_check"]["limit"].get<double>(), 1e-11);
+}
+
 }  // namespace
 }  // namespace physval
