@@ -745,12 +745,24 @@ static bool zeno_bounce(World& w, std::uint32_t i, double dt, std::span<const st
   mu.clear();
   rest_e.clear();
   touching_supports(w, i, near, contacts, mu, &rest_e);
-  if (contacts.size() != 1 || !(contacts[0].other & kBodySupport)) return false;
+  if (contacts.size() != 1) return false;
+  const Vec2 n = contacts[0].n;
+  const double vn = dot(w.vel[i], n);
+  const double an = dot(w.acc[i], n);
+  constexpr double ulps = 64.0 * 2.220446049250313e-16;
+  if (!(contacts[0].other & kBodySupport)) {
+    // One static circle, met straight along its normal (circle_tail, exact_collisions.cpp:
+    // the sixteenth hunt's ball bouncing on the top of a static circle).
+    const std::uint32_t j = contacts[0].other;
+    if (j >= w.size() || !w.is_static(j)) return false;
+    const PairMaterial m = w.pair_material(w.material[i], w.material[j]);
+    if (!(m.restitution > 0.0 && m.restitution < 1.0)) return false;
+    if (length(w.vel[i] - vn * n) > ulps * length(w.vel[i]) || length(w.acc[i] - an * n) > ulps * length(w.acc[i])) return false;
+    return an < 0.0 && std::fabs(vn) > ulps * (length(w.vel[i]) + std::fabs(an) * dt);
+  }
   const Segment& s = w.statics.segments[contacts[0].other & ~kBodySupport];
-  if (!World::zeno_material(w.pair_material(w.material[i], s.material), w.vel[i], w.acc[i], contacts[0].n)) return false;
-  const double vn = dot(w.vel[i], contacts[0].n);
-  const double an = dot(w.acc[i], contacts[0].n);
-  return an < 0.0 && std::fabs(vn) > 64.0 * 2.220446049250313e-16 * (length(w.vel[i]) + std::fabs(an) * dt);
+  if (!World::zeno_material(w.pair_material(w.material[i], s.material), w.vel[i], w.acc[i], n)) return false;
+  return an < 0.0 && std::fabs(vn) > ulps * (length(w.vel[i]) + std::fabs(an) * dt);
 }
 
 bool try_hold(World& w, std::uint32_t i, double dt, std::span<const std::uint32_t> near, bool settle_into_pocket) {
