@@ -1366,39 +1366,52 @@ class EventLoop {
     for (std::uint32_t o : w_.found_static) {
       if (o != k) return false;
     }
-    // Taken. Contacts: this impact, and any after a flight longer than the window.
-    const std::uint32_t partner = static_partner_key(seg.owner);
+    // Taken. At rest on the face from t + D (the normal speed is 0 there: settle_on_face
+    // removes only round-off).
+    take_tail(z, kNone, &seg, t_abs, tail_box, event, [&] { settle_on_face(w_, i, k, n, m); });
+    return true;
+  }
+
+  // Puts body z.body on its Zeno tail z (from z.t0 to z.t_end, this step's part): the
+  // tail's contacts with its partner (face `seg`, or static body `partner_body` with seg
+  // null): this impact, and any after a flight longer than the window; its closed-form
+  // state at z.t_end, its broad-phase box grown to tail_box; from z.t0 + z.D, when the step
+  // holds it, at rest on the partner (rest()), else free in its bounce at the step's end.
+  // Keeps z for unwind_tail.
+  template <class Rest>
+  void take_tail(Tail& z, std::uint32_t partner_body, const Segment* seg, double t_abs, const Aabb& tail_box, bool event,
+                 Rest rest) {
+    const std::uint32_t i = z.body;
     if (event) {
-      record_contact(w_, i, kNone, &seg, t_abs, ctx_.dt);
-      double tk = t, vk = v0;
+      record_contact(w_, i, partner_body, seg, t_abs, ctx_.dt);
+      double tk = z.t0, vk = z.v0;
       for (int q = 0; q < 64; ++q) {   // flights shrink: only the first few can exceed dt
-        const double flight = 2.0 * vk / a;
-        if (!(flight > ctx_.dt) || tk + flight > t + S) break;
+        const double flight = 2.0 * vk / z.a;
+        if (!(flight > ctx_.dt) || tk + flight > z.t_end) break;
         tk += flight;
-        vk *= e;
-        record_contact(w_, i, kNone, &seg, ctx_.t0 + tk, ctx_.dt);
+        vk *= z.e;
+        record_contact(w_, i, partner_body, seg, ctx_.t0 + tk, ctx_.dt);
       }
     }
     Vec2 pos, vel;
-    tail_state(z, t + S, pos, vel);
-    if (event) touch_contact(w_, i, partner, ctx_.t0 + tail_last_impact(z, t + S));
+    tail_state(z, z.t_end, pos, vel);
+    if (event) {
+      touch_contact(w_, i, seg ? static_partner_key(seg->owner) : partner_body, ctx_.t0 + tail_last_impact(z, z.t_end));
+    }
     w_.pos[i] = pos;
     w_.vel[i] = vel;
-    w_.tloc[i] = t + S;
+    w_.tloc[i] = z.t_end;
     ++w_.version[i];
     w_.bp->grow(i, tail_box);
-    if (D <= T_ - t) {
-      // At rest on the face from t + D (the normal speed is 0 there: settle_on_face
-      // removes only round-off).
-      settle_on_face(w_, i, k, n, m);
+    if (z.D <= T_ - z.t0) {
+      rest();
       ++w_.version[i];
-      reschedule(i, t + D);
+      reschedule(i, z.t0 + z.D);
     } else {
       w_.apath[i] = w_.acc[i];   // free, in bounce n at the step's end
     }
     z.version = w_.version[i];
     tails_.push_back(z);
-    return true;
   }
 
   // The same Zeno tail on a static circle (the sixteenth hunt): body i, free and alone,
@@ -1449,34 +1462,7 @@ class EventLoop {
     if (!w_.found_static.empty()) return false;
     Tail z{i, kNone, 0u, t, t + S, D, v0, a, e, p, vt, at, nb};
     z.partner = j;
-    if (event) {
-      record_contact(w_, i, j, nullptr, t_abs, ctx_.dt);
-      double tk = t, vk = v0;
-      for (int q = 0; q < 64; ++q) {   // flights shrink: only the first few can exceed dt
-        const double flight = 2.0 * vk / a;
-        if (!(flight > ctx_.dt) || tk + flight > t + S) break;
-        tk += flight;
-        vk *= e;
-        record_contact(w_, i, j, nullptr, ctx_.t0 + tk, ctx_.dt);
-      }
-    }
-    Vec2 pos, vel;
-    tail_state(z, t + S, pos, vel);
-    if (event) touch_contact(w_, i, j, ctx_.t0 + tail_last_impact(z, t + S));
-    w_.pos[i] = pos;
-    w_.vel[i] = vel;
-    w_.tloc[i] = t + S;
-    ++w_.version[i];
-    w_.bp->grow(i, tail_box);
-    if (D <= T_ - t) {
-      rest_on_body(w_, i, j, nb);   // at rest on top of it from t + D
-      ++w_.version[i];
-      reschedule(i, t + D);
-    } else {
-      w_.apath[i] = w_.acc[i];   // free, in bounce n at the step's end
-    }
-    z.version = w_.version[i];
-    tails_.push_back(z);
+    take_tail(z, j, nullptr, t_abs, tail_box, event, [&] { rest_on_body(w_, i, j, nb); });   // at rest on its top
     return true;
   }
 

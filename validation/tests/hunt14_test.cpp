@@ -12,6 +12,7 @@
 #include <string>
 
 #include "../src/containment.hpp"
+#include "containment_fixture.hpp"
 #include "physval_command.hpp"
 
 namespace physval {
@@ -26,30 +27,9 @@ class Hunt14 : public physval_test::TempDirTest {
   Hunt14() : TempDirTest("physval_hunt14_") {}
 };
 
-BodyState at(Vec2 x, Vec2 v = {}) {
-  BodyState s;
-  s.position = x;
-  s.velocity = v;
-  s.alive = true;
-  return s;
-}
-
-WallDef wall(const char* name, Vec2 a, Vec2 b) {
-  WallDef w;
-  w.name = name;
-  w.from = a;
-  w.to = b;
-  return w;
-}
-
-BodyDef ball(const char* name, Vec2 x, double r, bool is_static = false) {
-  BodyDef b;
-  b.name = name;
-  b.radius = r;
-  b.position = x;
-  b.is_static = is_static;
-  return b;
-}
+using containment_test::at;
+using containment_test::ball;
+using containment_test::wall;
 
 // A ball of radius r moved in three steps from above an opening to below it, through the
 // opening's middle (x = 1): the monitor's escapes.
