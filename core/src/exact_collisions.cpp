@@ -1414,8 +1414,9 @@ class EventLoop {
     tails_.push_back(z);
   }
 
-  // The same Zeno tail on a static circle (the sixteenth hunt): body i, free and alone,
-  // meets static body j at t slowly enough to collapse, with its velocity and acceleration
+  // The same Zeno tail on a static circle (the sixteenth hunt), or on a ball resting on a
+  // level floor (the seventeenth: World::firm_circle): body i, free and alone, meets that
+  // body j at t slowly enough to collapse, with its velocity and acceleration
   // along the contact normal nb (from j's centre to i's) to round-off (64 ulps of |v| and
   // |a|: dropped straight onto the top of the circle, the field through its centre), e0 in
   // (0, 1). Every bounce then leaves and returns along nb to the same contact point, so the
@@ -1426,8 +1427,7 @@ class EventLoop {
   // `ok`. Off the normal (a drop beside the top) the bounces walk off the circle and the
   // collapse decides as before (README, Known limits). False when a condition fails.
   bool circle_tail(std::uint32_t i, std::uint32_t j, Vec2 nb, double e0, double t, double t_abs, bool event) {
-    if (!zeno_tails_ || !(e0 > 0.0 && e0 < 1.0)) return false;
-    if ((w_.flags[j] & kStatic) == 0 || !(w_.radius[j] > 0.0)) return false;
+    if (!zeno_tails_ || !(e0 > 0.0 && e0 < 1.0) || !w_.firm_circle(j, nb)) return false;
     if (w_.supported(i) || w_.stationary(i) || !(w_.radius[i] > 0.0) || !(w_.inv_mass[i] > 0.0)) return false;
     if (w_.flags[i] & (kParticle | kPoint | kDestroyOnHit)) return false;
     if (!w_.dep_head.empty() && w_.dep_head[i] != kNone) return false;
@@ -1457,8 +1457,9 @@ class EventLoop {
     for (std::uint32_t x : near_) {
       if (x != i && x != j && w_.alive(x)) return false;
     }
+    // No face within touch of the tail's path (the partner's own floor, 2 R below, is not).
     w_.found_static.clear();
-    w_.statics.query(wide, w_.found_static);
+    w_.statics.query(tail_box, w_.found_static);
     if (!w_.found_static.empty()) return false;
     Tail z{i, kNone, 0u, t, t + S, D, v0, a, e, p, vt, at, nb};
     z.partner = j;

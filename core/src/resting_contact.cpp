@@ -754,7 +754,7 @@ static bool zeno_bounce(World& w, std::uint32_t i, double dt, std::span<const st
     // One static circle, met straight along its normal (circle_tail, exact_collisions.cpp:
     // the sixteenth hunt's ball bouncing on the top of a static circle).
     const std::uint32_t j = contacts[0].other;
-    if (j >= w.size() || !w.is_static(j)) return false;
+    if (j >= w.size() || !w.firm_circle(j, n)) return false;
     const PairMaterial m = w.pair_material(w.material[i], w.material[j]);
     if (!(m.restitution > 0.0 && m.restitution < 1.0)) return false;
     if (length(w.vel[i] - vn * n) > ulps * length(w.vel[i]) || length(w.acc[i] - an * n) > ulps * length(w.acc[i])) return false;

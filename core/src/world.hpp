@@ -381,6 +381,39 @@ struct World {
   bool stuck(std::uint32_t i) const {
     return supported(i) && vel[i].x == 0.0 && vel[i].y == 0.0 && apath[i].x == 0.0 && apath[i].y == 0.0;
   }
+  // A circle a body bouncing straight along n (unit, from it towards the bouncer) meets as
+  // if it were fixed: a static circle, or a body stuck on one face whose normal is n (to 64
+  // ulps: a ball resting on a level floor under a ball dropped onto its top). Each impact
+  // presses the latter into its face, which takes it whole (the simultaneous law: the face's
+  // contact, at rest, stays at rest), so the bouncer rebounds at e exactly as off a fixed
+  // circle (exact_collisions.cpp, circle_tail).
+  bool firm_circle(std::uint32_t j, Vec2 n) const {
+    if (!(radius[j] > 0.0)) return false;
+    if (is_static(j)) return true;
+    if (!stuck(j)) return false;
+    constexpr double ulps = 64.0 * 2.220446049250313e-16;
+    if (!on_body(j) && support[j] < statics.segments.size()) {
+      return dot(support_n[j], n) > 0.0 && std::fabs(cross(support_n[j], n)) <= ulps;
+    }
+    if (!is_held(j)) return false;
+    // Held on its supports together (kHeld): firm along n when one of them is a face under
+    // it with normal n, touching (the others can only add to what it takes).
+    thread_local std::vector<std::uint32_t> found;
+    found.clear();
+    const Vec2 foot = pos[j] - radius[j] * n;
+    const double tol = 1e-9 * (radius[j] + length_scale);
+    statics.query(make_aabb(foot.x - tol, foot.y - tol, foot.x + tol, foot.y + tol), found);
+    for (std::uint32_t k : found) {
+      const Segment& s = statics.segments[k];
+      const Vec2 sn = dot(s.normal, n) >= 0.0 ? s.normal : -1.0 * s.normal;
+      const double u = dot(foot - s.from, s.dir);
+      if (std::fabs(cross(sn, n)) <= ulps && u >= 0.0 && u <= s.length &&
+          std::fabs(dot(pos[j] - s.from, sn) - radius[j]) <= tol) {
+        return true;
+      }
+    }
+    return false;
+  }
   Vec2 path_acc(std::uint32_t i) const { return apath.empty() ? Vec2{} : apath[i]; }
   Vec2 force_acc(std::uint32_t i) const { return acc.empty() ? Vec2{} : acc[i]; }
   // The acceleration that presses contacts: the constrained one for a supported body.

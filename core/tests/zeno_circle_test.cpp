@@ -83,4 +83,37 @@ TEST(CoreZenoCircle, ABallDroppedStraightOntoAStaticCircleMeetsTheClosedForm) {
   EXPECT_EQ(cases, 96);
 }
 
+// The seventeenth hunt: the same drop onto a ball resting on a level floor (bottom mass 1e-3
+// to 1e6 of the top's: under the simultaneous law the floor takes each impact whole, so the
+// top ball rebounds at e as off a fixed circle). Every step's end at the closed form, and the
+// bottom ball never moves. Not at e 0.999 with the 1e-3 bottom: there, before the tail,
+// ~4000 bounces are met one by one, each a set of three contacts with a 1000:1 mass ratio,
+// and they end 2.2e-9 m off (4e-8 of the drop; measured, not traced: README, Known limits).
+TEST(CoreZenoCircle, ABallDroppedStraightOntoABallRestingOnAFloorMeetsTheClosedForm) {
+  const double g = 9.8, R = 0.5, r = 0.1, h = 0.05;
+  for (double e : {0.5, 0.99, 0.999}) {
+    for (double falls : {0.3, 3.0, 30.0, 150.0}) {
+      for (double mass : {1e-3, 1.0, 1e6}) {
+        if (e == 0.999 && mass == 1e-3) continue;   // above
+        SCOPED_TRACE("e " + std::to_string(e) + " falls " + std::to_string(falls) + " bottom mass " + std::to_string(mass));
+        const double tf = std::sqrt(2.0 * h / g), dt = falls * tf, rest = tf * (1.0 + e) / (1.0 - e);
+        Scene s = scene_of({circle("top", {0.0, 2.0 * R + r + h}, {}, r, 1.0, e), circle("bottom", {0.0, R}, {}, R, mass, e)},
+                           {wall("floor", {-2.0, 0.0}, {2.0, 0.0}, e)}, {0.0, -g});
+        Sim sim(s);
+        const int n = std::min(4000, static_cast<int>(std::ceil((rest * 1.2 + 2.0 * dt) / dt)));
+        double worst = 0.0, bottom = 0.0;
+        for (int k = 1; k <= n; ++k) {
+          sim.step(dt);
+          ASSERT_TRUE(sim.engine.broken_guarantee().empty()) << sim.engine.broken_guarantee();
+          const double above = sim.state(0).position.y - (2.0 * R + r);
+          worst = std::max(worst, std::fabs(above - zeno_height(h, g, e, sim.engine.time())));
+          bottom = std::max(bottom, length(sim.state(1).position - Vec2{0.0, R}));
+        }
+        EXPECT_LE(worst, 1e-9 * h + 64e-12 * (2.0 * R + r + h)) << "worst " << worst;
+        EXPECT_LE(bottom, 1e-12);
+      }
+    }
+  }
+}
+
 }  // namespace physval::test
