@@ -1455,7 +1455,11 @@ class EventLoop {
     near_.clear();
     w_.bp->query_box(wide, i, near_);
     for (std::uint32_t x : near_) {
-      if (x != i && x != j && w_.alive(x)) return false;
+      if (x == i || x == j || !w_.alive(x)) continue;
+      // A body at rest that does not reach the tail's own box (the balls under j in a
+      // stack) can neither meet the ball nor be met by it.
+      if (w_.stationary(x) && !overlaps(w_.bp->box(x), tail_box)) continue;
+      return false;
     }
     // No face within touch of the tail's path (the partner's own floor, 2 R below, is not).
     w_.found_static.clear();

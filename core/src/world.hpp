@@ -387,21 +387,22 @@ struct World {
   // presses the latter into its face, which takes it whole (the simultaneous law: the face's
   // contact, at rest, stays at rest), so the bouncer rebounds at e exactly as off a fixed
   // circle (exact_collisions.cpp, circle_tail).
-  bool firm_circle(std::uint32_t j, Vec2 n) const {
+  bool firm_circle(std::uint32_t j, Vec2 n, int depth = 0) const {
     if (!(radius[j] > 0.0)) return false;
     if (is_static(j)) return true;
-    if (!stuck(j)) return false;
+    if (!stuck(j) || depth > 16) return false;
     constexpr double ulps = 64.0 * 2.220446049250313e-16;
-    if (!on_body(j) && support[j] < statics.segments.size()) {
-      return dot(support_n[j], n) > 0.0 && std::fabs(cross(support_n[j], n)) <= ulps;
-    }
+    const auto along = [&](Vec2 u) { return dot(u, n) > 0.0 && std::fabs(cross(u, n)) <= ulps; };
+    if (!on_body(j) && support[j] < statics.segments.size()) return along(support_n[j]);
+    // On one body (a stack): firm when that body is, along the same line.
+    if (on_body(j) && !is_held(j)) return along(support_n[j]) && firm_circle(support[j] & ~kBodySupport, n, depth + 1);
     if (!is_held(j)) return false;
-    // Held on its supports together (kHeld): firm along n when one of them is a face under
-    // it with normal n, touching (the others can only add to what it takes).
-    thread_local std::vector<std::uint32_t> found;
-    found.clear();
+    // Held on its supports together (kHeld): firm along n when one of them is under it along
+    // n, touching: a face with normal n, or a body that is firm along n itself (the others
+    // can only add to what it takes).
     const Vec2 foot = pos[j] - radius[j] * n;
     const double tol = 1e-9 * (radius[j] + length_scale);
+    std::vector<std::uint32_t> found;
     statics.query(make_aabb(foot.x - tol, foot.y - tol, foot.x + tol, foot.y + tol), found);
     for (std::uint32_t k : found) {
       const Segment& s = statics.segments[k];
@@ -411,6 +412,15 @@ struct World {
           std::fabs(dot(pos[j] - s.from, sn) - radius[j]) <= tol) {
         return true;
       }
+    }
+    found.clear();
+    bp->query_box(make_aabb(foot.x - tol, foot.y - tol, foot.x + tol, foot.y + tol), j, found);
+    for (std::uint32_t k : found) {
+      if (k == j || !alive(k) || !(radius[k] > 0.0)) continue;
+      const Vec2 d = pos[j] - pos[k];
+      const double dl = length(d);
+      if (!(dl > 0.0) || std::fabs(dl - (radius[j] + radius[k])) > tol) continue;
+      if (along(d / dl) && firm_circle(k, n, depth + 1)) return true;
     }
     return false;
   }
