@@ -12,28 +12,9 @@
 #include <string>
 
 #include "scene_fixture.hpp"
+#include "zeno_closed_form.hpp"
 
 namespace physval::test {
-
-namespace {
-
-// Height above the contact of a ball released at rest h above it, under |g|, restitution e,
-// at time t: free fall, then bounces k = 0, 1, ... leaving at t_f + D (1 - e^k) with speed
-// v0 e^k (v0 = e g t_f, D = 2 v0 / (g (1 - e))), at rest from t_f + D.
-double zeno_height(double h, double g, double e, double t) {
-  const double tf = std::sqrt(2.0 * h / g);
-  if (t <= tf) return h - 0.5 * g * t * t;
-  const double v0 = e * g * tf, D = 2.0 * v0 / (g * (1.0 - e));
-  const double u = t - tf;
-  if (u >= D) return 0.0;
-  int k = 0;
-  while (D * (1.0 - std::pow(e, k + 1)) <= u) ++k;
-  const double s = u - D * (1.0 - std::pow(e, k));
-  const double vk = v0 * std::pow(e, k);
-  return std::max(0.0, s * (vk - 0.5 * g * s));
-}
-
-}  // namespace
 
 // Drops straight onto static circles: e 0.5 to 0.999, steps of 0.3 to 300 falls, the field
 // down or sideways (the ball placed up the field from the circle's centre; along an axis, so
@@ -67,7 +48,7 @@ TEST(CoreZenoCircle, ABallDroppedStraightOntoAStaticCircleMeetsTheClosedForm) {
             sim.step(dt);
             const BodyState b = sim.state(0);
             const double above = dot(b.position, up) - (sz.R + sz.r);
-            const double want = zeno_height(sz.h, g, e, sim.engine.time());
+            const double want = zeno::height(sz.h, g, e, sim.engine.time());
             worst = std::max(worst, std::fabs(above - want));
             ASSERT_TRUE(sim.engine.broken_guarantee().empty()) << sim.engine.broken_guarantee();
           }
@@ -106,7 +87,7 @@ TEST(CoreZenoCircle, ABallDroppedStraightOntoABallRestingOnAFloorMeetsTheClosedF
           sim.step(dt);
           ASSERT_TRUE(sim.engine.broken_guarantee().empty()) << sim.engine.broken_guarantee();
           const double above = sim.state(0).position.y - (2.0 * R + r);
-          worst = std::max(worst, std::fabs(above - zeno_height(h, g, e, sim.engine.time())));
+          worst = std::max(worst, std::fabs(above - zeno::height(h, g, e, sim.engine.time())));
           bottom = std::max(bottom, length(sim.state(1).position - Vec2{0.0, R}));
         }
         EXPECT_LE(worst, 1e-9 * h + 64e-12 * (2.0 * R + r + h)) << "worst " << worst;
@@ -136,7 +117,7 @@ TEST(CoreZenoCircle, ABallDroppedStraightOntoAStackOfTwoAtACoarseStepMeetsTheClo
         sim.step(dt);
         ASSERT_TRUE(sim.engine.broken_guarantee().empty()) << sim.engine.broken_guarantee();
         const double above = sim.state(0).position.y - (4.0 * R + r);
-        worst = std::max(worst, std::fabs(above - zeno_height(h, g, e, sim.engine.time())));
+        worst = std::max(worst, std::fabs(above - zeno::height(h, g, e, sim.engine.time())));
       }
       EXPECT_LE(worst, 1e-9 * h + 64e-12 * (4.0 * R + r + h)) << "worst " << worst;
     }
@@ -174,7 +155,7 @@ TEST(CoreZenoCircle, ABallDroppedStraightOntoAColumnBouncesAsOnAFloor) {
             sim.step(dt);
             ASSERT_TRUE(sim.engine.broken_guarantee().empty()) << sim.engine.broken_guarantee();
             const double above = sim.state(0).position.y - top;
-            worst = std::max(worst, std::fabs(above - zeno_height(h, g, e, sim.engine.time())));
+            worst = std::max(worst, std::fabs(above - zeno::height(h, g, e, sim.engine.time())));
             for (int c = 0; c < n; ++c) {
               column = std::max(column, length(sim.state(static_cast<std::size_t>(c + 1)).position - Vec2{0.0, R + 2.0 * R * c}));
             }

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "physval_command.hpp"
+#include "../../core/tests/zeno_closed_form.hpp"
 
 namespace physval {
 namespace {
@@ -26,20 +27,6 @@ class Hunt16 : public physval_test::TempDirTest {
  protected:
   Hunt16() : TempDirTest("physval_hunt16_") {}
 };
-
-// Height above the contact of a ball released at rest h above it (closed form).
-double zeno_height(double h, double g, double e, double t) {
-  const double tf = std::sqrt(2.0 * h / g);
-  if (t <= tf) return h - 0.5 * g * t * t;
-  const double v0 = e * g * tf, D = 2.0 * v0 / (g * (1.0 - e));
-  const double u = t - tf;
-  if (u >= D) return 0.0;
-  int k = 0;
-  while (D * (1.0 - std::pow(e, k + 1)) <= u) ++k;
-  const double s = u - D * (1.0 - std::pow(e, k));
-  const double vk = v0 * std::pow(e, k);
-  return std::max(0.0, s * (vk - 0.5 * g * s));
-}
 
 // Both reproducers through `physval run`: core `ok` against a converged reference, and its
 // series (every sample) at the closed form to 1e-9 of the drop (before: held from the first
@@ -93,7 +80,7 @@ TEST_F(Hunt16, ABallBouncingOnAStaticCircleMeetsTheClosedForm) {
       // The drop's 1e-9, and the CSV's 12 significant digits of the position and of the time
       // (times the fastest speed, sqrt(2 g h)).
       const double allowed = 1e-9 * c.h + 1e-11 * (c.rest_y + std::sqrt(2.0 * c.g * c.h) * v[0]);
-      worst = std::max(worst, std::fabs((v[col] - c.rest_y) - zeno_height(c.h, c.g, c.e, v[0])) / allowed);
+      worst = std::max(worst, std::fabs((v[col] - c.rest_y) - zeno::height(c.h, c.g, c.e, v[0])) / allowed);
       ++rows;
     }
     EXPECT_GT(rows, 5);
