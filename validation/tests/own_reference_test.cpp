@@ -172,6 +172,27 @@ TEST(OwnReference, NoVerdictWithoutAConvergedReference) {
   EXPECT_TRUE(has(run.reference_check.note, "no verdict possible: the reference did not converge")) << run.reference_check.note;
 }
 
+// A large scene's reference at dt/2 is checked by a run at dt itself, which is core's own run
+// where core claims exact paths: no verdict (a judgement that cannot fail), and a moved run
+// stays ok with the note. (Made so by the test: the scene is small.)
+TEST(OwnReference, NoVerdictWhereTheReferencesCheckRunIsCoresOwnStep) {
+  const Scene scene = test::load_builtin("basics/free_fall_floor.toml");
+  RunOptions ro;
+  ro.isolate = false;
+  Reference ref = make_reference(scene, ro);
+  ASSERT_TRUE(ref.converged) << ref.reason;
+  RunRecord run = run_engine(scene, *find_engine("core"), ro);
+  RunRecord judged = run;
+  compare_run(judged, scene, ref, false);
+  EXPECT_TRUE(judged.reference_check.judged) << judged.reference_check.note;   // at dt/8: judged
+  ref.dt = scene.dt / 2.0;
+  run.series.states[run.series.time.size() / 2][0].position.y += 1.0;
+  compare_run(run, scene, ref, false);
+  EXPECT_EQ(run.status, RunStatus::Ok) << run.reason;
+  EXPECT_FALSE(run.reference_check.judged);
+  EXPECT_TRUE(has(run.reference_check.note, "checked by a run at this run's own step")) << run.reference_check.note;
+}
+
 // A chaotic scene: the built-in gas. Its reference does not converge, so core is judged by
 // conservation alone, as every engine is there, and the note says so.
 TEST(OwnReference, ChaoticGasGetsNoPointwiseVerdict) {
