@@ -445,13 +445,13 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       // first 1-3 impacts and pair by pair after: the bounce lost again, and an elastic one
       // switching between the two reached the event cap). Far below any pile's or crystal's
       // angles.
-      constexpr double ulps = 1e-6;
+      constexpr double line_tol = 1e-6;
       // Only along the force that holds the column together (its weight): a line of
       // centres across a crystal or a pile (the hexagonal packing's 60-degree lines) is no
       // column, and the set would spread through every ball on it.
       const Vec2 a = w.force_acc(i);
       const double al = length(a);
-      if (!(al > 0.0) || dot(a, push) <= 0.0 || std::fabs(cross(a / al, push)) > ulps) return true;
+      if (!(al > 0.0) || dot(a, push) <= 0.0 || std::fabs(cross(a / al, push)) > line_tol) return true;
       const Vec2 p = pos_now(w, i, t);
       thread_local std::vector<std::uint32_t> near;
       near.clear();
@@ -461,7 +461,7 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
         if (k == i || !eligible(k) || !(w.radius[k] > 0.0)) continue;
         const Vec2 d = pos_now(w, k, t) - p;
         const double dl = length(d);
-        if (!(dl > 0.0) || dot(d, push) <= 0.0 || std::fabs(cross(d / dl, push)) > ulps) continue;
+        if (!(dl > 0.0) || dot(d, push) <= 0.0 || std::fabs(cross(d / dl, push)) > line_tol) continue;
         if (!consider(i, k)) return false;
         column.push_back(i);
         column.push_back(k);
