@@ -12,8 +12,10 @@ namespace physval::core_detail {
 
 // B: R rows by C columns, column-major (B[k * R + i] is row i of column k); y: R values.
 // x: the solution (C values). A column enters while its gradient B^T (y - B x) exceeds
-// 1e-13 max|y|. False if it does not finish (3 C + 30 additions, C + 10 inner steps each)
-// or an active set is singular (a column's remaining norm <= 1e-13 of B's largest entry).
+// 1e-13 max|y|; a column that would make the active set singular (a column's remaining norm
+// <= 1e-13 of B's largest entry, or more columns than rows) is passed over until another
+// enters. False if it does not finish (3 C + 30 additions, C + 10 inner steps each) or a set
+// turns singular within an addition's inner steps.
 bool nnls(std::size_t R, std::size_t C, const std::vector<double>& B, const std::vector<double>& y,
           std::vector<double>& x);
 
