@@ -258,3 +258,51 @@ TEST(CoreZenoCircle, ABallDroppedOntoAColumnBetweenTouchingWallsBouncesAsOnAFloo
 }
 
 }  // namespace physval::test
+
+namespace physval::test {
+
+// The nineteenth hunt's tall columns: 12 to 30 balls under the drop, met as a column at
+// their first 1-3 impacts only in the version it hunted (then pair by pair: rebounds at
+// e^2 u, or a 1 g column stopping the drop dead, `ok`, up to 0.96 of the drop off); right
+// since the column's line test is to 1e-6 rad (README, the nineteenth hunt). The closed form
+// at every step's end, the column still.
+TEST(CoreZenoCircle, ABallDroppedOntoATallColumnBouncesAsOnAFloor) {
+  const double g = 9.8, R = 0.5, r = 0.1, h = 1.0;
+  int cases = 0;
+  for (int n : {12, 20, 30}) {
+    for (double e : {0.9, 0.99}) {
+      for (double mass : {1e-3, 1.0}) {
+        for (double falls : {0.1, 3.0}) {
+          // Open (README, Known limits): on 20 and 30 balls at e 0.9 and 3 falls a step, the
+          // tail ends at rest at 8.13 s, 0.45 s early (0.0027 m, a 0.025 m/s bounce).
+          if (n >= 20 && e == 0.9 && falls == 3.0) continue;
+          SCOPED_TRACE("column of " + std::to_string(n) + " e " + std::to_string(e) + " column mass " + std::to_string(mass) +
+                       " falls " + std::to_string(falls));
+          const double tf = std::sqrt(2.0 * h / g), dt = falls * tf;
+          const double top = 2.0 * R * n + r;
+          std::vector<BodyDef> bodies{circle("top", {0.0, top + h}, {}, r, 1.0, e)};
+          for (int k = 0; k < n; ++k) bodies.push_back(circle("c" + std::to_string(k), {0.0, R + 2.0 * R * k}, {}, R, mass, e));
+          Sim sim(scene_of(bodies, {wall("floor", {-3.0, 0.0}, {3.0, 0.0}, e)}, {0.0, -g}));
+          const int steps = static_cast<int>(std::ceil(8.0 / dt));   // 8 s: 9 bounces at e 0.99
+          double worst = 0.0, column = 0.0;
+          for (int k = 1; k <= steps; ++k) {
+            sim.step(dt);
+            ASSERT_TRUE(sim.engine.broken_guarantee().empty()) << sim.engine.broken_guarantee();
+            worst = std::max(worst, std::fabs(sim.state(0).position.y - top - zeno::height(h, g, e, sim.engine.time())));
+            for (int c = 0; c < n; ++c) {
+              const BodyState b = sim.state(static_cast<std::size_t>(c + 1));
+              column = std::max(column, length(b.position - Vec2{0.0, R + 2.0 * R * c}));
+            }
+          }
+          EXPECT_LE(worst, 1e-9 * h + 64e-12 * (top + h)) << "worst " << worst;
+          EXPECT_LE(column, 1e-12);
+          EXPECT_TRUE(sim.engine.limits_hit().empty());
+          ++cases;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(cases, 20);
+}
+
+}  // namespace physval::test
