@@ -460,10 +460,11 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
       std::sort(near.begin(), near.end());
       // Struck along its weight: the body right under it on that line (a column), if there is
       // one. Else, pressed into its supports (the push has a part along its weight: a ball
-      // struck on top of a pyramid, in a hopper): every body under it (its centre more than
-      // line_tol rad below the horizontal through i's, seen along the weight) takes the push
-      // with it, and the set goes on down through them to the faces (twentieth hunt: at e 0.5
-      // a 10 kg ball dropped on a pyramid braced in a box stopped dead on its top, `ok`).
+      // struck on top of a pyramid, in a hopper, a ball landing in the groove of a bed of
+      // balls): every body under it (its centre more than line_tol rad below the horizontal
+      // through i's, seen along the weight) and every body the push presses it towards takes
+      // the push with it, and the set goes on through them to the faces (twentieth hunt: at e
+      // 0.5 a 10 kg ball dropped on a pyramid braced in a box stopped dead on its top, `ok`).
       bool on_line = false;
       for (int pass = 0; pass < 2; ++pass) {
         if (pass == 1 && on_line) break;
@@ -475,8 +476,8 @@ bool resolve_simultaneous(World& w, std::uint32_t i0, std::uint32_t j0, double t
           if (pass == 0) {
             if (!along || dot(d, push) <= 0.0 || std::fabs(cross(d / dl, push)) > line_tol) continue;
             on_line = true;
-          } else if (!(dot(d / dl, a / al) > line_tol)) {
-            continue;
+          } else if (!(dot(d / dl, a / al) > line_tol) && !(dot(d / dl, push) > line_tol)) {
+            continue;   // neither under it nor where the push presses it (a bed's next ball)
           }
           if (!consider(i, k)) return false;
           column.push_back(i);
