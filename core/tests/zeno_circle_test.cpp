@@ -396,3 +396,65 @@ TEST(CoreZenoCircle, ABallDroppedOnABracedPyramidBouncesAsOnAFloor) {
 }
 
 }  // namespace physval::test
+
+#include <random>
+
+namespace physval::test {
+
+// The twentieth hunt: a striker into a touching row of mixed masses on a frictionless floor,
+// e 0: all move on at the common velocity m0 u / sum m, whatever it is, slower than the rest
+// speed or not (the floor takes no horizontal impulse). Before, the exact solve left the row
+// at one velocity but for a few ulps, the striker "closed" on the ball ahead at 3e-17 m/s, the
+// same set was met 64 times at one instant and then taken as a collapse that held the back of
+// the row at rest: 1.85% of the momentum gone (one of the random rows below, kept first), and
+// in the hunt a 1.17 g pellet at 90 m/s lost 99.9%. The hunt's reproducer first, then 40 random
+// rows (3-8 balls and 1-3 touching strikers of 1e-3 to 1e3 kg), each run 2 s at dt 1/60.
+TEST(CoreRow, APerfectlyInelasticRowOnAFrictionlessFloorKeepsItsMomentum) {
+  struct Row {
+    std::vector<double> m;
+    int strikers;
+    double u;
+  };
+  std::vector<Row> rows{{{0.26926782330794835, 5.877060886910641, 3.3076501486511445, 437.77868236274713, 43.390761613711035,
+                          0.09533089927280076, 20.914342224871515},
+                         1,
+                         0.1249375624260917}};
+  std::mt19937_64 rng(20);
+  std::uniform_real_distribution<double> logm(-3.0, 3.0), logu(-3.0, 0.0);
+  std::uniform_int_distribution<int> count(3, 8), strikers(1, 3);
+  for (int r = 0; r < 40; ++r) {
+    Row row;
+    row.strikers = strikers(rng);
+    const int n = count(rng) + row.strikers;
+    for (int k = 0; k < n; ++k) row.m.push_back(std::pow(10.0, logm(rng)));
+    row.u = std::pow(10.0, logu(rng));
+    rows.push_back(row);
+  }
+  int cases = 0;
+  for (const Row& row : rows) {
+    SCOPED_TRACE("row " + std::to_string(cases));
+    const double R = 0.5, gap = 0.3 * row.u;
+    std::vector<BodyDef> bodies;
+    double msum = 0.0, p = 0.0;
+    for (std::size_t k = 0; k < row.m.size(); ++k) {
+      const bool striker = static_cast<int>(k) < row.strikers;
+      const double x = static_cast<double>(k) * 2.0 * R - (striker ? gap : 0.0);
+      bodies.push_back(circle("b" + std::to_string(k), {x, R}, {striker ? row.u : 0.0, 0.0}, R, row.m[k], 0.0));
+      msum += row.m[k];
+      if (striker) p += row.m[k] * row.u;
+    }
+    Sim sim(scene_of(bodies, {wall("floor", {-60.0, 0.0}, {60.0, 0.0}, 0.0)}, {0.0, -9.8}));
+    for (int k = 0; k < 120; ++k) sim.step(1.0 / 60.0);
+    ASSERT_TRUE(sim.engine.broken_guarantee().empty()) << sim.engine.broken_guarantee();
+    const double V = p / msum;
+    for (std::size_t k = 0; k < row.m.size(); ++k) {
+      const BodyState b = sim.state(k);
+      EXPECT_NEAR(b.velocity.x, V, 1e-9 * row.u) << "body " << k;
+      EXPECT_EQ(b.velocity.y, 0.0) << "body " << k;
+    }
+    ++cases;
+  }
+  EXPECT_EQ(cases, 41);
+}
+
+}  // namespace physval::test
