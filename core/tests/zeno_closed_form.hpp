@@ -23,4 +23,13 @@ inline double height(double h, double g, double e, double t) {
   return std::max(0.0, s * (vk - 0.5 * g * s));
 }
 
+// The same for any e in (0, 1], e = 1 being the same drop for ever (period 2 t_f).
+inline double bounce_height(double h, double g, double e, double t) {
+  if (e < 1.0) return height(h, g, e, t);
+  const double tf = std::sqrt(2.0 * h / g);
+  if (t <= tf) return h - 0.5 * g * t * t;
+  const double u = std::fmod(t - tf, 2.0 * tf);
+  return u * (g * tf - 0.5 * g * u);
+}
+
 }  // namespace physval::zeno
